@@ -1,0 +1,183 @@
+//! Watertight ray-triangle intersection (Woop, Benthin and Wald, "Watertight Ray/Triangle
+//! Intersection", JCGT 2013), in the form of pbrt-v4's `IntersectTriangle`.
+//!
+//! Why this and not Möller-Trumbore: the edge functions are evaluated in a ray-aligned frame where a
+//! point on an edge shared by two triangles gets the same value (of opposite sign) from both, so a ray
+//! can never slip between neighbours; rays from inside a closed mesh always hit it. Edge functions that
+//! round to exactly zero are recomputed in double precision. The returned `t` is conservatively positive:
+//! a hit closer than the floating-point error of `t` itself is rejected.
+
+use crate::math::{Ray, Vec3};
+
+/// A hit on a triangle: distance and the barycentric weights of its second and third vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Weight of vertex 1 (vertex 0 has `1 - b1 - b2`).
+    pub b1: f32,
+    /// Weight of vertex 2.
+    pub b2: f32,
+}
+
+#[inline]
+fn permute(v: Vec3, kx: usize, ky: usize, kz: usize) -> Vec3 {
+    Vec3::new(v[kx], v[ky], v[kz])
+}
+
+/// The hit of `ray` with triangle `(p0, p1, p2)` in `(0, t_max)`, if any. With `ray.cull_backfaces`,
+/// triangles whose counter-clockwise side faces away from the ray are skipped.
+#[inline]
+pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriHit> {
+    if ray.cull_backfaces && ray.dir.dot((p1 - p0).cross(p2 - p0)) >= 0.0 {
+        return None;
+    }
+    let d = ray.dir;
+    let ad = d.abs();
+    let kz = if ad.x > ad.y && ad.x > ad.z {
+        0
+    } else if ad.y > ad.z {
+        1
+    } else {
+        2
+    };
+    let kx = if kz == 2 { 0 } else { kz + 1 };
+    let ky = if kx == 2 { 0 } else { kx + 1 };
+    let d = permute(d, kx, ky, kz);
+    let mut a = permute(p0 - ray.origin, kx, ky, kz);
+    let mut b = permute(p1 - ray.origin, kx, ky, kz);
+    let mut c = permute(p2 - ray.origin, kx, ky, kz);
+
+    let sz = 1.0 / d.z;
+    let sx = -d.x * sz;
+    let sy = -d.y * sz;
+    a.x += sx * a.z;
+    a.y += sy * a.z;
+    b.x += sx * b.z;
+    b.y += sy * b.z;
+    c.x += sx * c.z;
+    c.y += sy * c.z;
+
+    let mut e0 = b.x * c.y - b.y * c.x;
+    let mut e1 = c.x * a.y - c.y * a.x;
+    let mut e2 = a.x * b.y - a.y * b.x;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        e0 = (b.x as f64 * c.y as f64 - b.y as f64 * c.x as f64) as f32;
+        e1 = (c.x as f64 * a.y as f64 - c.y as f64 * a.x as f64) as f32;
+        e2 = (a.x as f64 * b.y as f64 - a.y as f64 * b.x as f64) as f32;
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+
+    a.z *= sz;
+    b.z *= sz;
+    c.z *= sz;
+    let t_scaled = e0 * a.z + e1 * b.z + e2 * c.z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if !(t < t_max) {
+        return None;
+    }
+
+    // Reject hits whose t is within its own rounding error of zero (pbrt-v4, section 6.8.4).
+    let gamma = |n: f32| (n * f32::EPSILON * 0.5) / (1.0 - n * f32::EPSILON * 0.5);
+    let max_zt = Vec3::new(a.z, b.z, c.z).abs().max_element();
+    let delta_z = gamma(3.0) * max_zt;
+    let max_xt = Vec3::new(a.x, b.x, c.x).abs().max_element();
+    let max_yt = Vec3::new(a.y, b.y, c.y).abs().max_element();
+    let delta_x = gamma(5.0) * (max_xt + max_zt);
+    let delta_y = gamma(5.0) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2.0) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = Vec3::new(e0, e1, e2).abs().max_element();
+    let delta_t =
+        3.0 * (gamma(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some(TriHit {
+        t,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const P0: Vec3 = Vec3::new(-1.0, -1.0, 0.0);
+    const P1: Vec3 = Vec3::new(1.0, -1.0, 0.0);
+    const P2: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+
+    #[test]
+    fn triangle_hit_reports_distance_and_barycentrics() {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        let h = intersect_triangle(&ray, P0, P1, P2, f32::INFINITY).unwrap();
+        assert!((h.t - 5.0).abs() < 1e-6);
+        let p = (1.0 - h.b1 - h.b2) * P0 + h.b1 * P1 + h.b2 * P2;
+        assert!(p.abs_diff_eq(Vec3::ZERO, 1e-6));
+    }
+
+    #[test]
+    fn triangle_miss_outside_and_beyond_t_max_and_behind() {
+        let ray = Ray::new(Vec3::new(2.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_triangle(&ray, P0, P1, P2, f32::INFINITY).is_none());
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_triangle(&ray, P0, P1, P2, 4.9).is_none());
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, 1.0));
+        assert!(intersect_triangle(&ray, P0, P1, P2, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn triangle_backface_culling_only_when_asked() {
+        let from_back = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::new(0.0, 0.0, 1.0));
+        assert!(intersect_triangle(&from_back, P0, P1, P2, f32::INFINITY).is_some());
+        assert!(
+            intersect_triangle(&from_back.with_culling(true), P0, P1, P2, f32::INFINITY).is_none()
+        );
+        let from_front = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(
+            intersect_triangle(&from_front.with_culling(true), P0, P1, P2, f32::INFINITY).is_some()
+        );
+    }
+
+    #[test]
+    fn triangle_shared_edge_is_hit_by_exactly_one_side_or_both() {
+        // Two triangles sharing the edge x = 0; rays straight down that edge must hit at least one.
+        let q0 = Vec3::new(0.0, -1.0, 0.0);
+        let q1 = Vec3::new(0.0, 1.0, 0.0);
+        let left = Vec3::new(-1.0, 0.3, 0.0);
+        let right = Vec3::new(1.0, -0.2, 0.0);
+        for k in 0..1000 {
+            let y = -0.999 + k as f32 * 0.001998;
+            let ray = Ray::new(Vec3::new(0.0, y, 3.7), Vec3::new(0.0, 0.0, -1.0));
+            let a = intersect_triangle(&ray, q0, q1, left, f32::INFINITY);
+            let b = intersect_triangle(&ray, q1, q0, right, f32::INFINITY);
+            assert!(
+                a.is_some() || b.is_some(),
+                "ray at y={y} slipped through the shared edge"
+            );
+        }
+    }
+
+    #[test]
+    fn triangle_degenerate_and_nan_rays_hit_nothing() {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_triangle(&ray, P0, P0, P2, f32::INFINITY).is_none());
+        let nan = Ray::new(Vec3::new(f32::NAN, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_triangle(&nan, P0, P1, P2, f32::INFINITY).is_none());
+        let in_plane = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0));
+        assert!(intersect_triangle(&in_plane, P0, P1, P2, f32::INFINITY).is_none());
+    }
+}

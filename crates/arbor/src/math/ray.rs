@@ -1,0 +1,45 @@
+//! A ray with the reciprocal direction cached for slab tests.
+
+use super::Vec3;
+
+/// A half-line `origin + t * dir`, `t > 0`. `dir` need not be unit length (t is then in units of `dir`).
+#[derive(Debug, Clone, Copy)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Direction.
+    pub dir: Vec3,
+    /// `1 / dir` per component (infinite for zero components), for box tests.
+    pub inv_dir: Vec3,
+    /// Skip triangles seen from behind (primary rays only, when asked for).
+    pub cull_backfaces: bool,
+}
+
+impl Ray {
+    /// A ray that sees both sides of triangles.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Ray {
+            origin,
+            dir,
+            inv_dir: dir.recip(),
+            cull_backfaces: false,
+        }
+    }
+    /// The same ray, culling back faces or not.
+    #[inline]
+    pub fn with_culling(mut self, cull: bool) -> Self {
+        self.cull_backfaces = cull;
+        self
+    }
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + t * self.dir
+    }
+    /// True when origin and direction are finite and the direction is not zero: others hit nothing.
+    #[inline]
+    pub fn is_valid(&self) -> bool {
+        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO
+    }
+}

@@ -1,0 +1,3 @@
+//! (being written)
+/// Placeholder element tree.
+pub struct Node;
