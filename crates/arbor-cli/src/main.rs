@@ -1,1 +1,78 @@
-fn main() {}
+//! `arbor`: render scene files, describe them, compare images.
+//!
+//! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
+//! 4 I/O failure.
+
+mod diff;
+mod info;
+mod render;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// A ray tracer for triangle meshes built around fast and exactly correct acceleration structures.
+#[derive(Parser)]
+#[command(name = "arbor", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render every camera of a scene (METU XML/JSON, NYU scene.json) to the image it names.
+    Render(render::RenderArgs),
+    /// Describe a scene: cameras, lights, materials, objects, triangle counts, structure statistics.
+    Info(info::InfoArgs),
+    /// Compare an image with a reference: PSNR and the share of pixels off by more than a threshold.
+    Diff(diff::DiffArgs),
+}
+
+/// How a command ended, when not in success.
+pub enum Failure {
+    /// The comparison was above its threshold (exit 1).
+    TooDifferent,
+    /// An error from the library (exit 3 for bad input, 4 for I/O).
+    Arbor(arbor::Error),
+}
+
+impl From<arbor::Error> for Failure {
+    fn from(e: arbor::Error) -> Self {
+        Failure::Arbor(e)
+    }
+}
+
+/// Which threads to use: `--threads N`, or all cores.
+pub fn set_threads(threads: Option<usize>) -> Result<(), Failure> {
+    if let Some(n) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+            .map_err(|e| arbor::Error::Invalid(format!("cannot start {n} threads: {e}")))?;
+    }
+    Ok(())
+}
+
+/// The scene argument as a display name.
+pub fn shown(path: &Option<PathBuf>) -> String {
+    path.as_ref().map_or_else(|| "(built-in example)".to_string(), |p| p.display().to_string())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Info(args) => info::run(args),
+        Command::Diff(args) => diff::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::TooDifferent) => ExitCode::from(1),
+        Err(Failure::Arbor(e)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(if e.is_io() { 4 } else { 3 })
+        }
+    }
+}

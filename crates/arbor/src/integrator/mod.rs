@@ -1,1 +1,5 @@
-//! (being written)
+//! Integrators: what colour a camera ray brings back.
+
+mod whitted;
+
+pub use whitted::Whitted;

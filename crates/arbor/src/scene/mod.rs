@@ -4,16 +4,20 @@
 //! The METU XML and JSON forms share one reader: both are first turned into the same element tree
 //! ([`tree`]), and one interpreter ([`metu`]) reads the scene from that tree.
 
+mod build;
 pub mod desc;
 mod json;
 mod metu;
 mod nyu_json;
+mod runtime;
 mod tree;
 mod xml;
 
 use std::path::Path;
 
+pub use build::{build_geometry, SceneCounts, SceneGeometry, ScenePrims};
 pub use desc::*;
+pub use runtime::{Scene, Surface};
 
 use crate::{Error, Location, Result};
 
@@ -21,24 +25,22 @@ use crate::{Error, Location, Result};
 /// `scene.json` form, told apart by their top-level keys).
 pub fn load_desc(path: &Path) -> Result<SceneDesc> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        Error::input(
-            Location::byte(path, e.utf8_error().valid_up_to() as u64),
-            "not UTF-8 text",
-        )
-    })?;
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let text = String::from_utf8(bytes)
+        .map_err(|e| Error::input(Location::byte(path, e.utf8_error().valid_up_to() as u64), "not UTF-8 text"))?;
+    parse_desc(&text, path)
+}
+
+/// Reads a scene from `text` as if it were the file `path` (whose extension picks the format and whose
+/// folder anchors relative mesh paths).
+pub fn parse_desc(text: &str, path: &Path) -> Result<SceneDesc> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "xml" => metu::read(&xml::parse(&text, path)?, path),
+        "xml" => metu::read(&xml::parse(text, path)?, path),
         "json" => {
-            if nyu_json::looks_like_nyu(&text) {
-                nyu_json::parse(&text, path)
+            if nyu_json::looks_like_nyu(text) {
+                nyu_json::parse(text, path)
             } else {
-                metu::read(&json::parse(&text, path)?, path)
+                metu::read(&json::parse(text, path)?, path)
             }
         }
         _ => Err(Error::input(

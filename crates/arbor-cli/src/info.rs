@@ -1,0 +1,103 @@
+//! `arbor info`: what a scene contains and what its acceleration structure looks like once built.
+
+use std::path::PathBuf;
+
+use arbor::accel::AccelKind;
+use arbor::scene::{LightDesc, MaterialKind, MeshSource, Scene, ShapeDesc};
+use clap::Args;
+
+use crate::Failure;
+
+/// Arguments of `arbor info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// Scene file (.xml or .json). Without one, describes the built-in example.
+    pub scene: Option<PathBuf>,
+    /// Acceleration structure to build and report on.
+    #[arg(long, default_value = "bvh-sah", value_parser = |s: &str| s.parse::<AccelKind>())]
+    pub accel: AccelKind,
+}
+
+/// Runs `arbor info`.
+pub fn run(args: InfoArgs) -> Result<(), Failure> {
+    let desc = crate::render::read_scene(&args.scene)?;
+    println!("scene      {}", crate::shown(&args.scene));
+    println!(
+        "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",
+        desc.background, desc.ambient, desc.max_depth, desc.shadow_epsilon
+    );
+    for c in &desc.cameras {
+        println!(
+            "camera {}   {}x{}  {} spp  -> {}{}",
+            c.id,
+            c.width,
+            c.height,
+            c.num_samples,
+            c.image_name,
+            if c.orthographic { "  (orthographic)" } else { "" }
+        );
+    }
+    for l in &desc.lights {
+        match l {
+            LightDesc::Point { position, intensity } => println!("light      point at {position}, intensity {intensity}"),
+            LightDesc::Area { position, size, radiance, .. } => {
+                println!("light      area {size}x{size} at {position}, radiance {radiance}")
+            }
+            LightDesc::Directional { direction, radiance } => {
+                println!("light      directional along {direction}, radiance {radiance}")
+            }
+        }
+    }
+    for m in &desc.materials {
+        let kind = match m.kind {
+            MaterialKind::BlinnPhong => "blinn-phong",
+            MaterialKind::Mirror { .. } => "mirror",
+            MaterialKind::Conductor { .. } => "conductor",
+            MaterialKind::Dielectric { .. } => "dielectric",
+            MaterialKind::Transparent { .. } => "transparent (legacy)",
+        };
+        println!("material {}  {kind}", m.id);
+    }
+    for o in &desc.objects {
+        let what = match &o.shape {
+            ShapeDesc::Mesh { source: MeshSource::Inline(m), smooth } => {
+                format!("mesh, {} triangles inline{}", m.len(), if *smooth { ", smooth" } else { "" })
+            }
+            ShapeDesc::Mesh { source: MeshSource::File(p), smooth } => {
+                format!("mesh from {}{}", p.display(), if *smooth { ", smooth" } else { "" })
+            }
+            ShapeDesc::Sphere { radius, .. } => format!("sphere, radius {radius}"),
+            ShapeDesc::Plane { .. } => "plane".to_string(),
+            ShapeDesc::Instance { base } => format!("instance of {}", desc.objects[*base].name),
+        };
+        println!("object     {}: {what}", o.name);
+    }
+    for w in &desc.warnings {
+        println!("warning    {w}");
+    }
+    let scene = Scene::build(desc, args.accel, None)?;
+    let g = &scene.geometry.counts;
+    println!(
+        "geometry   {} triangles ({} degenerate), {} spheres, {} planes; bounds {} .. {}; meshes read in {:.1} ms",
+        g.triangles,
+        g.degenerate,
+        g.spheres,
+        g.planes,
+        scene.geometry.bounds().min,
+        scene.geometry.bounds().max,
+        g.mesh_load.as_secs_f64() * 1e3
+    );
+    let s = scene.geometry.accel_stats();
+    println!(
+        "structure  {}: {} nodes, {} leaves, max depth {}, {:.2} primitives per leaf, SAH cost {:.2}, {} KiB, built in {:.1} ms",
+        s.kind,
+        s.nodes,
+        s.leaves,
+        s.max_depth,
+        s.mean_leaf_prims,
+        s.sah_cost,
+        s.bytes / 1024,
+        s.build_time.as_secs_f64() * 1e3
+    );
+    Ok(())
+}

@@ -1,0 +1,147 @@
+//! `arbor render`: every camera of a scene to the image file it names, with a progress bar on a terminal
+//! and one summary line per image.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use arbor::accel::AccelKind;
+use arbor::light::environment::EnvMap;
+use arbor::render::{render, RenderOptions};
+use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::Failure;
+
+/// The scene rendered when none is named: the repository's own Cornell box.
+const EXAMPLE_NAME: &str = "cornell_box.xml";
+const EXAMPLE: &str = include_str!("../../../examples/cornell_box.xml");
+
+/// Arguments of `arbor render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (.xml or .json). Without one, renders the built-in example Cornell box.
+    pub scene: Option<PathBuf>,
+    /// Folder for the images (created if missing); each camera's file name comes from the scene.
+    #[arg(short = 'o', long = "out", default_value = ".")]
+    pub out: PathBuf,
+    /// Acceleration structure.
+    #[arg(long, default_value = "bvh-sah", value_parser = parse_accel)]
+    pub accel: AccelKind,
+    /// Samples per pixel, overriding the scene's NumSamples.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub spp: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
+    /// (px nx py ny pz nz).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Skip triangles facing away from camera rays (the course's back-face culling).
+    #[arg(long, conflicts_with = "no_cull")]
+    pub cull: bool,
+    /// Never cull back faces, even when the scene asks for it.
+    #[arg(long)]
+    pub no_cull: bool,
+    /// Render only the camera with this id.
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// No progress bar and no summary lines.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_accel(s: &str) -> Result<AccelKind, String> {
+    s.parse()
+}
+
+/// Reads the scene named on the command line, or the built-in example.
+pub fn read_scene(scene: &Option<PathBuf>) -> Result<SceneDesc, Failure> {
+    Ok(match scene {
+        Some(path) => load_desc(path)?,
+        None => parse_desc(EXAMPLE, Path::new(EXAMPLE_NAME))?,
+    })
+}
+
+/// Runs `arbor render`.
+pub fn run(args: RenderArgs) -> Result<(), Failure> {
+    crate::set_threads(args.threads)?;
+    let t0 = Instant::now();
+    let desc = read_scene(&args.scene)?;
+    let parse_time = t0.elapsed();
+    for w in &desc.warnings {
+        if !args.quiet {
+            eprintln!("warning: {w}");
+        }
+    }
+    let cameras: Vec<usize> = match &args.camera {
+        None => (0..desc.cameras.len()).collect(),
+        Some(id) => {
+            let found: Vec<usize> = (0..desc.cameras.len()).filter(|&i| &desc.cameras[i].id == id).collect();
+            if found.is_empty() {
+                let ids: Vec<&str> = desc.cameras.iter().map(|c| c.id.as_str()).collect();
+                return Err(arbor::Error::Invalid(format!(
+                    "{}: no camera with id '{id}' (cameras: {})",
+                    crate::shown(&args.scene),
+                    ids.join(", ")
+                ))
+                .into());
+            }
+            found
+        }
+    };
+    if cameras.is_empty() {
+        return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
+    }
+    let env = args.env.as_deref().map(EnvMap::load).transpose()?;
+    let scene = Scene::build(desc, args.accel, env)?;
+    let opts = RenderOptions {
+        spp: args.spp,
+        cull_backfaces: if args.cull { Some(true) } else if args.no_cull { Some(false) } else { None },
+    };
+    for &c in &cameras {
+        let cam = &scene.desc.cameras[c];
+        let path = args.out.join(&cam.image_name);
+        let bar = progress_bar(args.quiet, cam.width as u64 * cam.height as u64, &cam.image_name);
+        let (film, stats) = render(&scene, c, &opts, &|done, _| bar.set_position(done));
+        bar.finish_and_clear();
+        arbor::image_io::write_image(&path, &film)?;
+        if !args.quiet {
+            let g = &scene.geometry.counts;
+            println!(
+                "{}  {}x{}  {} spp  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
+                 render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
+                path.display(),
+                cam.width,
+                cam.height,
+                stats.spp,
+                (parse_time + g.mesh_load).as_secs_f64() * 1e3,
+                scene.build_time.as_secs_f64() * 1e3,
+                args.accel,
+                g.triangles,
+                g.spheres,
+                g.planes,
+                stats.time.as_secs_f64() * 1e3,
+                stats.rays as f64 / 1e6,
+                stats.mrays_per_s()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A bar on standard error, drawn only on a terminal (indicatif hides it otherwise).
+fn progress_bar(quiet: bool, len: u64, name: &str) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(name.to_string());
+    bar
+}

@@ -1,0 +1,109 @@
+//! Whitted-style recursive ray tracing as the METU and NYU courses define it: ambient plus Blinn-Phong
+//! from every light that a shadow ray reaches, plus the specular lobes of mirrors, conductors and
+//! dielectrics up to the recursion limit, with Beer's law along every segment travelled inside glass.
+//!
+//! Secondary ray origins are pushed off the surface by the scene's `ShadowRayEpsilon` along the
+//! geometric normal, to the side the new ray leaves from, so a ray never re-hits its own surface.
+
+use crate::material::{beer, blinn_phong, specular_lobes};
+use crate::light::sample_light;
+use crate::math::{Color, Ray};
+use crate::sampler::Rng;
+use crate::scene::{MaterialKind, Scene};
+
+/// The integrator for one render.
+pub struct Whitted<'a> {
+    scene: &'a Scene,
+    cull_backfaces: bool,
+}
+
+impl<'a> Whitted<'a> {
+    /// An integrator over `scene`; `cull_backfaces` applies to camera rays only.
+    pub fn new(scene: &'a Scene, cull_backfaces: bool) -> Self {
+        Whitted { scene, cull_backfaces }
+    }
+
+    /// Radiance (in the scene's units) along a camera ray.
+    pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, count: &mut u64) -> Color {
+        self.li(&ray.with_culling(self.cull_backfaces), 0, None, rng, count)
+    }
+
+    /// Radiance along `ray` at recursion `depth`; `inside` is the absorption of the glass the ray travels
+    /// in, if any.
+    fn li(&self, ray: &Ray, depth: u32, inside: Option<Color>, rng: &mut Rng, count: &mut u64) -> Color {
+        let scene = self.scene;
+        *count += 1;
+        let Some(hit) = scene.geometry.intersect(ray, f32::INFINITY) else {
+            return self.miss(ray, depth);
+        };
+        let s = scene.surface(ray, &hit);
+        let m = scene.material(&s);
+        let d = ray.dir;
+        // Shade the side the ray arrives on: both normals are flipped towards it.
+        let front = d.dot(s.ng) < 0.0;
+        let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
+        let eps = scene.desc.shadow_epsilon;
+
+        let mut color = m.ambient * scene.desc.ambient;
+        // Light is measured at the surface point itself; only the shadow ray starts off the surface.
+        let shadow_origin = s.p + ng * eps;
+        for light in &scene.desc.lights {
+            let Some(ls) = sample_light(light, s.p, rng.next_2d()) else { continue };
+            if ns.dot(ls.wi) <= 0.0 {
+                continue;
+            }
+            *count += 1;
+            let shadow = if ls.dist.is_finite() {
+                Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
+            } else {
+                Ray::new(shadow_origin, ls.wi)
+            };
+            let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
+            if scene.geometry.occluded(&shadow, t_max) {
+                continue;
+            }
+            color += blinn_phong(m, ns, ls.wi, -d) * ls.irradiance;
+        }
+
+        if depth < scene.desc.max_depth && !matches!(m.kind, MaterialKind::BlinnPhong) {
+            // Lobes see the shading normal unless it disagrees with the geometric one about which side
+            // the ray comes from (possible at silhouettes of smooth meshes).
+            let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
+            for lobe in specular_lobes(&m.kind, d, n) {
+                if lobe.weight == Color::ZERO {
+                    continue;
+                }
+                let leaves_front = lobe.dir.dot(s.ng) > 0.0;
+                let origin = s.p + if leaves_front { s.ng } else { -s.ng } * eps;
+                // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
+                // a reflected one stays in whatever medium it was in.
+                let next_inside = match (lobe.transmitted, &m.kind) {
+                    (false, _) => inside,
+                    (true, MaterialKind::Dielectric { absorption, .. }) if front => Some(*absorption),
+                    (true, _) => None,
+                };
+                let l = self.li(&Ray::new(origin, lobe.dir), depth + 1, next_inside, rng, count);
+                color += lobe.weight * l;
+            }
+        }
+        match inside {
+            Some(absorption) => color * beer(absorption, hit.t * ray.dir.length()),
+            None => color,
+        }
+    }
+
+    /// What a ray that hits nothing sees: the environment map, else the background colour for camera
+    /// rays and black for the others.
+    fn miss(&self, ray: &Ray, depth: u32) -> Color {
+        let scene = self.scene;
+        if let Some(env) = &scene.environment {
+            return env.eval(ray.dir) / scene.desc.radiance_scale;
+        }
+        if depth == 0 {
+            scene.desc.background
+        } else {
+            Color::ZERO
+        }
+    }
+}
+
