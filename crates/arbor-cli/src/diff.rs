@@ -35,6 +35,11 @@ pub fn run(args: DiffArgs) -> Result<(), Failure> {
         );
         return Err(Failure::TooDifferent);
     }
-    println!("OK: {:.3}% of pixels off by more than {} levels (limit {}%)", c.share_off * 100.0, args.threshold, args.max_off);
+    println!(
+        "OK: {:.3}% of pixels off by more than {} levels (limit {}%)",
+        c.share_off * 100.0,
+        args.threshold,
+        args.max_off
+    );
     Ok(())
 }

@@ -39,7 +39,9 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     }
     for l in &desc.lights {
         match l {
-            LightDesc::Point { position, intensity } => println!("light      point at {position}, intensity {intensity}"),
+            LightDesc::Point { position, intensity } => {
+                println!("light      point at {position}, intensity {intensity}")
+            }
             LightDesc::Area { position, size, radiance, .. } => {
                 println!("light      area {size}x{size} at {position}, radiance {radiance}")
             }

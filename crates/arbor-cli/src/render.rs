@@ -98,7 +98,13 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let scene = Scene::build(desc, args.accel, env)?;
     let opts = RenderOptions {
         spp: args.spp,
-        cull_backfaces: if args.cull { Some(true) } else if args.no_cull { Some(false) } else { None },
+        cull_backfaces: if args.cull {
+            Some(true)
+        } else if args.no_cull {
+            Some(false)
+        } else {
+            None
+        },
     };
     for &c in &cameras {
         let cam = &scene.desc.cameras[c];

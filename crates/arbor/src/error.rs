@@ -20,30 +20,15 @@ pub struct Location {
 impl Location {
     /// The whole file, no position inside it.
     pub fn file(file: impl AsRef<Path>) -> Self {
-        Location {
-            file: file.as_ref().to_path_buf(),
-            line: None,
-            col: None,
-            byte: None,
-        }
+        Location { file: file.as_ref().to_path_buf(), line: None, col: None, byte: None }
     }
     /// A line (and column, when non-zero) in a text file.
     pub fn at(file: impl AsRef<Path>, line: u32, col: u32) -> Self {
-        Location {
-            file: file.as_ref().to_path_buf(),
-            line: Some(line),
-            col: (col > 0).then_some(col),
-            byte: None,
-        }
+        Location { file: file.as_ref().to_path_buf(), line: Some(line), col: (col > 0).then_some(col), byte: None }
     }
     /// A byte offset in a binary file.
     pub fn byte(file: impl AsRef<Path>, offset: u64) -> Self {
-        Location {
-            file: file.as_ref().to_path_buf(),
-            line: None,
-            col: None,
-            byte: Some(offset),
-        }
+        Location { file: file.as_ref().to_path_buf(), line: None, col: None, byte: Some(offset) }
     }
 }
 
@@ -90,17 +75,11 @@ pub enum Error {
 impl Error {
     /// An input error at `loc`.
     pub fn input(loc: Location, msg: impl Into<String>) -> Self {
-        Error::Input {
-            loc,
-            msg: msg.into(),
-        }
+        Error::Input { loc, msg: msg.into() }
     }
     /// An I/O error on `path`.
     pub fn io(path: impl AsRef<Path>, source: std::io::Error) -> Self {
-        Error::Io {
-            path: path.as_ref().to_path_buf(),
-            source,
-        }
+        Error::Io { path: path.as_ref().to_path_buf(), source }
     }
     /// True when the failure is the file system's rather than the input's (CLI exit code 4 vs 3).
     pub fn is_io(&self) -> bool {

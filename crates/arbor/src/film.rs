@@ -16,11 +16,7 @@ pub struct Film {
 impl Film {
     /// A black film.
     pub fn new(width: u32, height: u32) -> Self {
-        Film {
-            width,
-            height,
-            pixels: vec![Color::ZERO; width as usize * height as usize],
-        }
+        Film { width, height, pixels: vec![Color::ZERO; width as usize * height as usize] }
     }
     /// The pixel at column `x`, row `y`.
     #[inline]
@@ -30,11 +26,7 @@ impl Film {
     /// 8-bit RGB: each channel clamped to [0, 1], scaled to 255 and rounded to nearest, as the course
     /// references are made.
     pub fn to_rgb8(&self) -> Vec<u8> {
-        self.pixels
-            .iter()
-            .flat_map(|c| c.to_array())
-            .map(quantize)
-            .collect()
+        self.pixels.iter().flat_map(|c| c.to_array()).map(quantize).collect()
     }
 }
 

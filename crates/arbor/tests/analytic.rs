@@ -73,10 +73,7 @@ fn pixel(desc: SceneDesc) -> Color {
 }
 
 fn assert_close(got: Color, want: Color) {
-    assert!(
-        (got - want).abs().max_element() <= 1e-4 * want.abs().max_element().max(1.0),
-        "got {got}, want {want}"
-    );
+    assert!((got - want).abs().max_element() <= 1e-4 * want.abs().max_element().max(1.0), "got {got}, want {want}");
 }
 
 #[test]
@@ -143,11 +140,8 @@ fn analytic_glass_slab_with_beers_law() {
     let c = Color::new(0.1, 0.2, 0.05);
     let glass = material(0.0, 0.0, MaterialKind::Dielectric { eta, absorption: c });
     let wall = material(0.8, 0.0, MaterialKind::BlinnPhong);
-    let objects = vec![
-        object(quad(1.0, 5.0, true), 0),
-        object(quad(-1.0, 5.0, false), 0),
-        object(quad(-10.0, 50.0, true), 1),
-    ];
+    let objects =
+        vec![object(quad(1.0, 5.0, true), 0), object(quad(-1.0, 5.0, false), 0), object(quad(-10.0, 50.0, true), 1)];
     let f = ((eta - 1.0) / (eta + 1.0)).powi(2);
     let beer = (-c * 2.0).exp();
     let want = beer * (1.0 - f) * (1.0 - f) * 80.0;

@@ -157,7 +157,8 @@ fn metu_cases(root: &Path, ext: &str, refs: &[(&str, bool)]) -> (Vec<Case>, Vec<
 #[test]
 fn reference_ceng795_2024_xml() {
     let Some(dir) = common::scenes_dir() else { return };
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2024-hw1/hw1"), "xml", &[("outputs_nobfc", false), ("outputs", true)]);
+    let (cases, skipped) =
+        metu_cases(&dir.join("ceng795-2024-hw1/hw1"), "xml", &[("outputs_nobfc", false), ("outputs", true)]);
     assert!(cases.len() >= 15, "only {} cases found", cases.len());
     check(run("CENG 795 2024 XML", cases, skipped).1);
 }

@@ -67,11 +67,7 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
 
     fn validate(&self, prims: &P) -> Result<(), String> {
         if self.len != prims.len() {
-            return Err(format!(
-                "built over {} primitives, queried with {}",
-                self.len,
-                prims.len()
-            ));
+            return Err(format!("built over {} primitives, queried with {}", self.len, prims.len()));
         }
         Ok(())
     }

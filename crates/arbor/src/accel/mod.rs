@@ -44,12 +44,7 @@ impl Hit {
     /// `prim` and `h` as a hit.
     #[inline]
     pub fn new(prim: u32, h: PrimHit) -> Self {
-        Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        }
+        Hit { t: h.t, prim, u: h.u, v: h.v }
     }
     /// True when this hit should replace `best` (closer, or as close with a lower index).
     #[inline]
@@ -147,17 +142,10 @@ impl fmt::Display for AccelKind {
 impl FromStr for AccelKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        AccelKind::ALL
-            .iter()
-            .copied()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
-                format!(
-                    "unknown acceleration structure '{s}' (expected one of: {})",
-                    names.join(", ")
-                )
-            })
+        AccelKind::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown acceleration structure '{s}' (expected one of: {})", names.join(", "))
+        })
     }
 }
 

@@ -35,11 +35,7 @@ impl TriangleMesh {
     #[inline]
     pub fn triangle(&self, i: usize) -> [Vec3; 3] {
         let [a, b, c] = self.indices[i];
-        [
-            self.positions[a as usize],
-            self.positions[b as usize],
-            self.positions[c as usize],
-        ]
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
     }
     /// Bounds of the referenced vertices.
     pub fn bounds(&self) -> Aabb {
@@ -85,10 +81,7 @@ impl TriangleMesh {
         let mut out = TriangleMesh {
             positions: self.positions.iter().map(|&p| t.point(p)).collect(),
             indices: self.indices.clone(),
-            normals: self
-                .normals
-                .as_ref()
-                .map(|ns| ns.iter().map(|&n| (nm * n).normalize_or_zero()).collect()),
+            normals: self.normals.as_ref().map(|ns| ns.iter().map(|&n| (nm * n).normalize_or_zero()).collect()),
             uvs: self.uvs.clone(),
         };
         if t.flips_handedness() {
@@ -116,11 +109,7 @@ mod tests {
     fn mesh_vertex_normals_of_flat_quad_point_up() {
         let mut m = quad();
         m.compute_vertex_normals();
-        assert!(m
-            .normals
-            .unwrap()
-            .iter()
-            .all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)));
+        assert!(m.normals.unwrap().iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)));
     }
 
     #[test]

@@ -31,17 +31,10 @@ mod tests {
 
     #[test]
     fn plane_hit_parallel_and_behind() {
-        let p = Plane {
-            point: Vec3::new(0.0, -1.0, 0.0),
-            normal: Vec3::Y,
-        };
+        let p = Plane { point: Vec3::new(0.0, -1.0, 0.0), normal: Vec3::Y };
         let down = Ray::new(Vec3::ZERO, Vec3::new(0.0, -2.0, 0.0));
         assert!((p.intersect(&down, f32::INFINITY).unwrap() - 0.5).abs() < 1e-6);
-        assert!(p
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY)
-            .is_none());
-        assert!(p
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::Y), f32::INFINITY)
-            .is_none());
+        assert!(p.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY).is_none());
+        assert!(p.intersect(&Ray::new(Vec3::ZERO, Vec3::Y), f32::INFINITY).is_none());
     }
 }

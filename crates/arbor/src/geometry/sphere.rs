@@ -43,10 +43,7 @@ impl Sphere {
         let (o, d) = if self.transform.is_identity() {
             (ray.origin, ray.dir)
         } else {
-            (
-                self.transform.inv.transform_point3(ray.origin),
-                self.transform.inv.transform_vector3(ray.dir),
-            )
+            (self.transform.inv.transform_point3(ray.origin), self.transform.inv.transform_vector3(ray.dir))
         };
         let dd = d.length_squared();
         let f = o - self.center;
@@ -59,11 +56,7 @@ impl Sphere {
         // The two roots are q/|d|² and c/q; computing one from the other avoids cancellation.
         let q = b + disc.sqrt().copysign(b);
         let c = f.length_squared() - self.radius * self.radius;
-        let (r0, r1) = if q == 0.0 {
-            (0.0, 0.0)
-        } else {
-            (q / dd, c / q)
-        };
+        let (r0, r1) = if q == 0.0 { (0.0, 0.0) } else { (q / dd, c / q) };
         let (t0, t1) = if r0 <= r1 { (r0, r1) } else { (r1, r0) };
         [t0, t1].into_iter().find(|&t| t > 0.0 && t < t_max)
     }
@@ -83,51 +76,26 @@ mod tests {
     use super::*;
 
     fn unit() -> Sphere {
-        Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-            transform: Transform::IDENTITY,
-        }
+        Sphere { center: Vec3::ZERO, radius: 1.0, transform: Transform::IDENTITY }
     }
 
     #[test]
     fn sphere_hit_from_outside_and_inside() {
         let s = unit();
-        let t = s.intersect(
-            &Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0)),
-            f32::INFINITY,
-        );
+        let t = s.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0)), f32::INFINITY);
         assert!((t.unwrap() - 4.0).abs() < 1e-6);
-        let t = s.intersect(
-            &Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -2.0)),
-            f32::INFINITY,
-        );
+        let t = s.intersect(&Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -2.0)), f32::INFINITY);
         assert!((t.unwrap() - 0.5).abs() < 1e-6);
-        assert!(s
-            .intersect(
-                &Ray::new(Vec3::new(0.0, 2.0, 5.0), Vec3::new(0.0, 0.0, -1.0)),
-                f32::INFINITY
-            )
-            .is_none());
-        assert!(s
-            .intersect(
-                &Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, 1.0)),
-                f32::INFINITY
-            )
-            .is_none());
+        assert!(s.intersect(&Ray::new(Vec3::new(0.0, 2.0, 5.0), Vec3::new(0.0, 0.0, -1.0)), f32::INFINITY).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, 1.0)), f32::INFINITY).is_none());
     }
 
     #[test]
     fn sphere_scaled_into_ellipsoid() {
-        let s = Sphere {
-            transform: Transform::scale(Vec3::new(3.0, 1.0, 1.0)).unwrap(),
-            ..unit()
-        };
+        let s = Sphere { transform: Transform::scale(Vec3::new(3.0, 1.0, 1.0)).unwrap(), ..unit() };
         let ray = Ray::new(Vec3::new(10.0, 0.0, 0.0), Vec3::new(-1.0, 0.0, 0.0));
         assert!((s.intersect(&ray, f32::INFINITY).unwrap() - 7.0).abs() < 1e-5);
-        assert!(s
-            .normal_at(Vec3::new(3.0, 0.0, 0.0))
-            .abs_diff_eq(Vec3::X, 1e-6));
+        assert!(s.normal_at(Vec3::new(3.0, 0.0, 0.0)).abs_diff_eq(Vec3::X, 1e-6));
         assert!(s.bounds().max.abs_diff_eq(Vec3::new(3.0, 1.0, 1.0), 1e-6));
     }
 }

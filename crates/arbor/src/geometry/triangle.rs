@@ -100,16 +100,11 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     let delta_y = gamma(5.0) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2.0) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-    let delta_t =
-        3.0 * (gamma(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let delta_t = 3.0 * (gamma(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t {
         return None;
     }
-    Some(TriHit {
-        t,
-        b1: e1 * inv_det,
-        b2: e2 * inv_det,
-    })
+    Some(TriHit { t, b1: e1 * inv_det, b2: e2 * inv_det })
 }
 
 #[cfg(test)]
@@ -143,13 +138,9 @@ mod tests {
     fn triangle_backface_culling_only_when_asked() {
         let from_back = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::new(0.0, 0.0, 1.0));
         assert!(intersect_triangle(&from_back, P0, P1, P2, f32::INFINITY).is_some());
-        assert!(
-            intersect_triangle(&from_back.with_culling(true), P0, P1, P2, f32::INFINITY).is_none()
-        );
+        assert!(intersect_triangle(&from_back.with_culling(true), P0, P1, P2, f32::INFINITY).is_none());
         let from_front = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
-        assert!(
-            intersect_triangle(&from_front.with_culling(true), P0, P1, P2, f32::INFINITY).is_some()
-        );
+        assert!(intersect_triangle(&from_front.with_culling(true), P0, P1, P2, f32::INFINITY).is_some());
     }
 
     #[test]
@@ -164,10 +155,7 @@ mod tests {
             let ray = Ray::new(Vec3::new(0.0, y, 3.7), Vec3::new(0.0, 0.0, -1.0));
             let a = intersect_triangle(&ray, q0, q1, left, f32::INFINITY);
             let b = intersect_triangle(&ray, q1, q0, right, f32::INFINITY);
-            assert!(
-                a.is_some() || b.is_some(),
-                "ray at y={y} slipped through the shared edge"
-            );
+            assert!(a.is_some() || b.is_some(), "ray at y={y} slipped through the shared edge");
         }
     }
 

@@ -5,8 +5,8 @@
 //! Secondary ray origins are pushed off the surface by the scene's `ShadowRayEpsilon` along the
 //! geometric normal, to the side the new ray leaves from, so a ray never re-hits its own surface.
 
-use crate::material::{beer, blinn_phong, specular_lobes};
 use crate::light::sample_light;
+use crate::material::{beer, blinn_phong, specular_lobes};
 use crate::math::{Color, Ray};
 use crate::sampler::Rng;
 use crate::scene::{MaterialKind, Scene};
@@ -106,4 +106,3 @@ impl<'a> Whitted<'a> {
         }
     }
 }
-

@@ -1,6 +1,6 @@
 //! (being written: temporary stand-in with the final API)
-use std::path::Path;
 use crate::math::{Color, Vec3};
+use std::path::Path;
 /// Environment map.
 pub struct EnvMap;
 impl EnvMap {
@@ -9,5 +9,7 @@ impl EnvMap {
         Err(crate::Error::Invalid(format!("{}: environment maps not written yet", path.display())))
     }
     /// Looks up a direction.
-    pub fn eval(&self, _dir: Vec3) -> Color { Color::ZERO }
+    pub fn eval(&self, _dir: Vec3) -> Color {
+        Color::ZERO
+    }
 }

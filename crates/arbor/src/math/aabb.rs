@@ -19,10 +19,7 @@ impl Default for Aabb {
 
 impl Aabb {
     /// The box that contains nothing.
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     /// The box spanning two corners.
     #[inline]
@@ -46,18 +43,12 @@ impl Aabb {
     /// This box grown to include `p`.
     #[inline]
     pub fn grow(self, p: Vec3) -> Self {
-        Aabb {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
+        Aabb { min: self.min.min(p), max: self.max.max(p) }
     }
     /// The smallest box holding both.
     #[inline]
     pub fn union(self, o: Aabb) -> Self {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
     /// Size along each axis.
     #[inline]

@@ -19,12 +19,7 @@ impl Ray {
     /// A ray that sees both sides of triangles.
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Ray {
-            origin,
-            dir,
-            inv_dir: dir.recip(),
-            cull_backfaces: false,
-        }
+        Ray { origin, dir, inv_dir: dir.recip(), cull_backfaces: false }
     }
     /// The same ray, culling back faces or not.
     #[inline]

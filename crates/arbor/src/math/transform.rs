@@ -20,10 +20,7 @@ impl Default for Transform {
 
 impl Transform {
     /// The identity.
-    pub const IDENTITY: Transform = Transform {
-        m: Mat4::IDENTITY,
-        inv: Mat4::IDENTITY,
-    };
+    pub const IDENTITY: Transform = Transform { m: Mat4::IDENTITY, inv: Mat4::IDENTITY };
 
     /// From a matrix; `None` when it cannot be inverted (a zero scale, say).
     pub fn from_mat4(m: Mat4) -> Option<Self> {
@@ -31,17 +28,11 @@ impl Transform {
         if !det.is_finite() || det.abs() < 1e-30 {
             return None;
         }
-        Some(Transform {
-            m,
-            inv: m.inverse(),
-        })
+        Some(Transform { m, inv: m.inverse() })
     }
     /// A translation.
     pub fn translate(t: Vec3) -> Self {
-        Transform {
-            m: Mat4::from_translation(t),
-            inv: Mat4::from_translation(-t),
-        }
+        Transform { m: Mat4::from_translation(t), inv: Mat4::from_translation(-t) }
     }
     /// A scale; `None` when a factor is zero.
     pub fn scale(s: Vec3) -> Option<Self> {
@@ -51,17 +42,11 @@ impl Transform {
     pub fn rotate(deg: f32, axis: Vec3) -> Option<Self> {
         let axis = axis.try_normalize()?;
         let m = Mat4::from_axis_angle(axis, deg.to_radians());
-        Some(Transform {
-            m,
-            inv: m.transpose(),
-        })
+        Some(Transform { m, inv: m.transpose() })
     }
     /// `self` applied first, then `then`.
     pub fn then(&self, then: &Transform) -> Transform {
-        Transform {
-            m: then.m * self.m,
-            inv: self.inv * then.inv,
-        }
+        Transform { m: then.m * self.m, inv: self.inv * then.inv }
     }
     /// True for the identity (skips work on untransformed objects).
     pub fn is_identity(&self) -> bool {

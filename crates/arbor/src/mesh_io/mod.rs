@@ -6,8 +6,5 @@ use crate::Result;
 
 /// Loads a mesh file, picking the reader by extension.
 pub fn load_mesh(path: &Path) -> Result<TriangleMesh> {
-    Err(crate::Error::Invalid(format!(
-        "{}: mesh loading not written yet",
-        path.display()
-    )))
+    Err(crate::Error::Invalid(format!("{}: mesh loading not written yet", path.display())))
 }

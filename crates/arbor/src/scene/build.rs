@@ -186,14 +186,20 @@ pub fn build_geometry(desc: &SceneDesc, kind: AccelKind) -> Result<SceneGeometry
 fn resolve_instance(desc: &SceneDesc, index: usize, mut base: usize) -> Result<&ObjectDesc> {
     for _ in 0..desc.objects.len() {
         let object = desc.objects.get(base).ok_or_else(|| {
-            Error::input(desc.objects[index].loc.clone(), format!("{}: base object does not exist", desc.objects[index].name))
+            Error::input(
+                desc.objects[index].loc.clone(),
+                format!("{}: base object does not exist", desc.objects[index].name),
+            )
         })?;
         match object.shape {
             ShapeDesc::Instance { base: next } => base = next,
             _ => return Ok(object),
         }
     }
-    Err(Error::input(desc.objects[index].loc.clone(), format!("{}: instances refer to each other in a cycle", desc.objects[index].name)))
+    Err(Error::input(
+        desc.objects[index].loc.clone(),
+        format!("{}: instances refer to each other in a cycle", desc.objects[index].name),
+    ))
 }
 
 /// Reads every distinct mesh file once, in parallel. A failure names the object that asked for the file.

@@ -43,9 +43,6 @@ pub fn parse_desc(text: &str, path: &Path) -> Result<SceneDesc> {
                 metu::read(&json::parse(text, path)?, path)
             }
         }
-        _ => Err(Error::input(
-            Location::file(path),
-            format!("unknown scene format '.{ext}' (expected .xml or .json)"),
-        )),
+        _ => Err(Error::input(Location::file(path), format!("unknown scene format '.{ext}' (expected .xml or .json)"))),
     }
 }

@@ -68,8 +68,7 @@ impl Scene {
             let [a, b, c] = prims.triangle(i);
             let ng = (b - a).cross(c - a).normalize_or_zero();
             let [ia, ib, ic] = prims.triangles[i];
-            let (na, nb, nc) =
-                (prims.normals[ia as usize], prims.normals[ib as usize], prims.normals[ic as usize]);
+            let (na, nb, nc) = (prims.normals[ia as usize], prims.normals[ib as usize], prims.normals[ic as usize]);
             let ns = if na == Vec3::ZERO || nb == Vec3::ZERO || nc == Vec3::ZERO {
                 ng
             } else {

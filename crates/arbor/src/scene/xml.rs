@@ -1,8 +1,5 @@
 //! (being written)
 use super::tree::Node;
 pub fn parse(_text: &str, path: &std::path::Path) -> crate::Result<Node> {
-    Err(crate::Error::Invalid(format!(
-        "{}: XML reader not written yet",
-        path.display()
-    )))
+    Err(crate::Error::Invalid(format!("{}: XML reader not written yet", path.display())))
 }
