@@ -282,3 +282,98 @@ fn compare_files_counts_a_pixel_off_by_nine() {
     assert_eq!(c.share_off, 1.0 / 16.0);
     assert_eq!(compare_files(&reference, &image, 9).unwrap().pixels_off, 0);
 }
+
+fn solid(size: u32, c: Color) -> Film {
+    Film {
+        width: size,
+        height: size,
+        pixels: vec![c; (size * size) as usize],
+    }
+}
+
+#[test]
+fn envmap_loads_cube_faces_by_any_naming_scheme() {
+    use arbor::light::environment::EnvMap;
+    use arbor::math::Vec3;
+    let dir = tempfile::tempdir().unwrap();
+    let c = |v: f32| Color::new(v, 1.0 - v, 0.5);
+    let files = [
+        ("px.png", 0.0),
+        ("NEGX.PNG", 0.2),
+        ("top.exr", 0.4),
+        ("bottom.ppm", 0.6),
+        ("posz.png", 0.8),
+        ("back.png", 1.0),
+    ];
+    for (name, v) in files {
+        write_image(&dir.path().join(name), &solid(4, c(v))).unwrap();
+    }
+    fs::write(dir.path().join("readme.txt"), b"not a face").unwrap();
+    let map = EnvMap::load(dir.path()).unwrap();
+    assert!(map.is_cube_map());
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    for (axis, (name, v)) in axes.iter().zip(files) {
+        // 8-bit faces come back as levels / 255.
+        let want = Color::new(
+            arbor::film::quantize(c(v).x) as f32,
+            arbor::film::quantize(c(v).y) as f32,
+            arbor::film::quantize(c(v).z) as f32,
+        ) / 255.0;
+        let want = if name.ends_with(".exr") { c(v) } else { want };
+        let got = map.eval(*axis);
+        assert!(
+            (got - want).abs().max_element() < 1e-6,
+            "{name}: {got} vs {want}"
+        );
+    }
+}
+
+#[test]
+fn envmap_cube_directory_lists_missing_and_duplicate_faces() {
+    use arbor::light::environment::EnvMap;
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["px.png", "nx.png", "py.png", "nz.png"] {
+        write_image(&dir.path().join(name), &solid(2, Color::ONE)).unwrap();
+    }
+    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{}: cube map directory lacks faces -y (ny, negy, bottom); +z (pz, posz, front)",
+            dir.path().display()
+        )
+    );
+    write_image(&dir.path().join("ny.png"), &solid(2, Color::ONE)).unwrap();
+    write_image(&dir.path().join("front.png"), &solid(2, Color::ONE)).unwrap();
+    write_image(&dir.path().join("posz.exr"), &solid(2, Color::ONE)).unwrap();
+    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("two files for cube face +z"), "{err}");
+    fs::remove_file(dir.path().join("posz.exr")).unwrap();
+    write_image(&dir.path().join("ny.png"), &solid(3, Color::ONE)).unwrap();
+    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("ny.png") && err.contains("is 3x3 but face +x is 2x2"),
+        "{err}"
+    );
+}
+
+#[test]
+fn envmap_loads_latlong_file_and_names_missing_one() {
+    use arbor::light::environment::EnvMap;
+    use arbor::math::Vec3;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.exr");
+    let mut film = Film::new(4, 2);
+    // Top row bright (+y), bottom row dark.
+    for x in 0..4 {
+        film.pixels[x] = Color::splat(5.0);
+        film.pixels[4 + x] = Color::splat(0.25);
+    }
+    write_image(&path, &film).unwrap();
+    let map = EnvMap::load(&path).unwrap();
+    assert!(!map.is_cube_map());
+    assert_eq!(map.eval(Vec3::Y), Color::splat(5.0));
+    assert_eq!(map.eval(-Vec3::Y), Color::splat(0.25));
+    let err = EnvMap::load(&dir.path().join("nope.hdr")).unwrap_err();
+    assert!(err.to_string().contains("nope.hdr"), "{err}");
+}
