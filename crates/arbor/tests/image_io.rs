@@ -377,3 +377,32 @@ fn envmap_loads_latlong_file_and_names_missing_one() {
     let err = EnvMap::load(&dir.path().join("nope.hdr")).unwrap_err();
     assert!(err.to_string().contains("nope.hdr"), "{err}");
 }
+
+#[test]
+fn read_jpeg_and_radiance_hdr() {
+    let dir = tempfile::tempdir().unwrap();
+    let jpeg = dir.path().join("flat.JPG");
+    image::RgbImage::from_pixel(8, 8, image::Rgb([200, 100, 50]))
+        .save(&jpeg)
+        .unwrap();
+    let film = read_image(&jpeg).unwrap();
+    let want = Color::new(200.0, 100.0, 50.0) / 255.0;
+    assert!(
+        (film.get(3, 3) - want).abs().max_element() < 4.0 / 255.0,
+        "{}",
+        film.get(3, 3)
+    );
+
+    let hdr = dir.path().join("bright.hdr");
+    image::Rgb32FImage::from_pixel(2, 2, image::Rgb([4.0, 0.5, 100.0]))
+        .save(&hdr)
+        .unwrap();
+    let film = read_image(&hdr).unwrap();
+    let want = Color::new(4.0, 0.5, 100.0);
+    // RGBE keeps 8 mantissa bits shared by the three channels.
+    assert!(
+        ((film.get(1, 1) - want) / want).abs().max_element() < 0.01,
+        "{}",
+        film.get(1, 1)
+    );
+}
