@@ -1,1 +1,19 @@
-//! (being written)
+//! Image files in and out, and the numbers that say how far two images are apart.
+//!
+//! - [`write_image`]: a [`Film`](crate::film::Film) to PNG or binary PPM (8 bits per channel, quantised by
+//!   [`Film::to_rgb8`](crate::film::Film::to_rgb8)) or to OpenEXR (32-bit float RGB, unclamped). Writes are
+//!   atomic: the image goes to a temporary file in the target's directory which is then renamed over the
+//!   target, so a failed run never leaves a half-written image and never destroys the previous one.
+//! - [`read_image`]: PNG, JPEG, PNM, OpenEXR, Radiance HDR into a film in display units (integer samples
+//!   divided by their maximum, float samples as they are); [`read_rgb8`] for exact 8-bit comparisons.
+//! - [`metrics`]: PSNR, RMSE and the share of differing pixels against a reference image.
+//!
+//! Codecs are the `image` crate's; this module only chooses formats, converts samples and handles files.
+
+pub mod metrics;
+mod read;
+mod write;
+
+pub use metrics::{compare_files, compare_rgb8, diff_image, Comparison};
+pub use read::{read_image, read_rgb8};
+pub use write::{write_image, SUPPORTED_WRITE_EXTENSIONS};

@@ -1,0 +1,50 @@
+//! Reading images into films (display units) or into exact 8-bit RGB.
+//!
+//! The format is recognised by the file's first bytes, then by its extension. Integer samples are divided
+//! by their maximum (255 or 65535), float samples (EXR, HDR) are kept as they are; grey is expanded to RGB
+//! and alpha is dropped, never composited, because references are compared as stored.
+
+use std::path::Path;
+
+use image::{DynamicImage, ImageReader};
+
+use crate::error::{Error, Location, Result};
+use crate::film::Film;
+use crate::math::Color;
+
+/// Reads PNG, JPEG, PNM (8 or 16-bit), OpenEXR or Radiance HDR into a film. Errors name the file.
+pub fn read_image(path: &Path) -> Result<Film> {
+    let rgb = decode(path)?.into_rgb32f();
+    let (width, height) = rgb.dimensions();
+    let pixels = rgb
+        .into_raw()
+        .chunks_exact(3)
+        .map(|c| Color::new(c[0], c[1], c[2]))
+        .collect();
+    Ok(Film {
+        width,
+        height,
+        pixels,
+    })
+}
+
+/// Reads an image as 8-bit RGB, row-major from the top: `(width, height, bytes)`. 16-bit samples are
+/// rounded to 8 bits and float samples clamped to [0, 1] first.
+pub fn read_rgb8(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let rgb = decode(path)?.into_rgb8();
+    let (w, h) = rgb.dimensions();
+    Ok((w, h, rgb.into_raw()))
+}
+
+fn decode(path: &Path) -> Result<DynamicImage> {
+    let reader = ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| Error::io(path, e))?;
+    reader.decode().map_err(|e| match e {
+        image::ImageError::IoError(io) => Error::io(path, io),
+        other => Error::input(
+            Location::file(path),
+            format!("cannot decode image: {other}"),
+        ),
+    })
+}

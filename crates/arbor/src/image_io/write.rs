@@ -1,0 +1,141 @@
+//! Writing a film: the format follows the extension, and the file appears whole or not at all.
+//!
+//! The encoded image is built in memory first (an encoder failure never touches the disk), then written to
+//! `.<name>.<pid>.<n>.tmp` next to the target, flushed to disk and renamed over the target. A rename within
+//! one directory is atomic on POSIX and replaces the target on Windows, so readers see either the old image
+//! or the new one. On any failure the temporary file is removed.
+
+use std::fs;
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use image::codecs::openexr::OpenExrEncoder;
+use image::codecs::png::PngEncoder;
+use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+use image::{ExtendedColorType, ImageEncoder};
+
+use crate::error::{Error, Result};
+use crate::film::Film;
+
+/// The extensions [`write_image`] understands (compared case-insensitively).
+pub const SUPPORTED_WRITE_EXTENSIONS: &[&str] = &["png", "ppm", "exr"];
+
+#[derive(Clone, Copy)]
+enum Format {
+    Png,
+    Ppm,
+    Exr,
+}
+
+/// Writes `film` to `path`, choosing the format by the extension (case-insensitive): `png` (8-bit RGB),
+/// `ppm` (binary P6, 8-bit) or `exr` (32-bit float RGB, values as they are, including > 1 and < 0).
+///
+/// The parent directory is created when missing. The write is atomic: on failure an existing file at
+/// `path` is left untouched and no temporary file remains.
+pub fn write_image(path: &Path, film: &Film) -> Result<()> {
+    let format = format_of(path)?;
+    let expected = film.width as usize * film.height as usize;
+    if film.pixels.len() != expected || expected == 0 {
+        return Err(Error::Invalid(format!(
+            "cannot write {}: the film is {}x{} but holds {} pixels",
+            path.display(),
+            film.width,
+            film.height,
+            film.pixels.len()
+        )));
+    }
+    let bytes = encode(film, format)
+        .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
+    write_atomic(path, &bytes)
+}
+
+fn format_of(path: &Path) -> Result<Format> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => Ok(Format::Png),
+        Some("ppm") => Ok(Format::Ppm),
+        Some("exr") => Ok(Format::Exr),
+        other => {
+            let named = match other {
+                Some(e) => format!("unknown image extension \".{e}\""),
+                None => "no image extension".to_string(),
+            };
+            Err(Error::Invalid(format!(
+                "cannot write {}: {named}; supported: {}",
+                path.display(),
+                SUPPORTED_WRITE_EXTENSIONS.join(", ")
+            )))
+        }
+    }
+}
+
+fn encode(film: &Film, format: Format) -> image::ImageResult<Vec<u8>> {
+    let (w, h) = (film.width, film.height);
+    let mut out = Cursor::new(Vec::new());
+    match format {
+        Format::Png => {
+            PngEncoder::new(&mut out).write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?
+        }
+        Format::Ppm => PnmEncoder::new(&mut out)
+            .with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary))
+            .write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?,
+        Format::Exr => {
+            let bytes: Vec<u8> = film
+                .pixels
+                .iter()
+                .flat_map(|c| c.to_array())
+                .flat_map(f32::to_ne_bytes)
+                .collect();
+            OpenExrEncoder::new(&mut out).write_image(&bytes, w, h, ExtendedColorType::Rgb32F)?
+        }
+    }
+    Ok(out.into_inner())
+}
+
+/// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let (tmp, mut file) = create_temp(&dir, path)?;
+    let written = file
+        .write_all(bytes)
+        .and_then(|()| file.sync_all())
+        .map_err(|e| Error::io(&tmp, e));
+    drop(file);
+    let renamed = written.and_then(|()| fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    if renamed.is_err() {
+        // Best effort: the original error is the one worth reporting.
+        let _ = fs::remove_file(&tmp);
+    }
+    renamed
+}
+
+/// A new file named after the target, unique per process and call, so parallel writers never share one.
+fn create_temp(dir: &Path, target: &Path) -> Result<(PathBuf, fs::File)> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".to_string());
+    loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        match fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => return Ok((tmp, f)),
+            // A leftover from a killed run with the same pid: take the next number.
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(Error::io(&tmp, e)),
+        }
+    }
+}
