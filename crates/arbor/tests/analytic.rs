@@ -170,3 +170,31 @@ fn analytic_render_is_identical_for_any_thread_count() {
     };
     assert_eq!(run(1).pixels, run(3).pixels);
 }
+
+#[test]
+fn analytic_environment_seen_directly_and_in_a_mirror() {
+    use arbor::film::Film;
+    use arbor::light::environment::EnvMap;
+    // A lat-long map that is red in the -z half (the centre of the image) and blue elsewhere.
+    let (w, h) = (64, 32);
+    let mut film = Film::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            let red = (w / 4..3 * w / 4).contains(&x);
+            film.pixels[(y * w + x) as usize] = if red { Color::new(0.8, 0.0, 0.0) } else { Color::new(0.0, 0.0, 0.6) };
+        }
+    }
+    let env = || Some(EnvMap::from_film_latlong(film.clone()));
+    // Nothing in the scene: the camera looks down -z and sees red, in display units whatever the scale.
+    let mut desc = scene(vec![], vec![], vec![], 0);
+    desc.radiance_scale = 1.0 / 255.0;
+    let s = Scene::build(desc, AccelKind::BvhSah, env()).unwrap();
+    let (direct, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
+    assert_close(direct.pixels[0], Color::new(0.8, 0.0, 0.0));
+    // A mirror facing the camera sends the ray back along +z: blue, times the mirror's reflectance.
+    let mirror = material(0.0, 0.0, MaterialKind::Mirror { reflectance: Color::splat(0.5) });
+    let desc = scene(vec![mirror], vec![object(quad(0.0, 5.0, true), 0)], vec![], 1);
+    let s = Scene::build(desc, AccelKind::BvhSah, env()).unwrap();
+    let (reflected, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
+    assert_close(reflected.pixels[0], Color::new(0.0, 0.0, 0.3));
+}

@@ -52,15 +52,8 @@ fn ppm_round_trip_is_exact_binary_p6() {
     let film = level_film(5, 4);
     write_image(&path, &film).unwrap();
     let bytes = fs::read(&path).unwrap();
-    assert!(
-        bytes.starts_with(b"P6"),
-        "not binary PPM: {:?}",
-        &bytes[..2]
-    );
-    assert!(
-        bytes.ends_with(&film.to_rgb8()),
-        "pixel data is not the 8-bit film"
-    );
+    assert!(bytes.starts_with(b"P6"), "not binary PPM: {:?}", &bytes[..2]);
+    assert!(bytes.ends_with(&film.to_rgb8()), "pixel data is not the 8-bit film");
     assert_eq!(read_rgb8(&path).unwrap(), (5, 4, film.to_rgb8()));
 }
 
@@ -97,10 +90,7 @@ fn write_quantises_half_levels_up_and_clamps() {
     ]
     .map(Color::splat)
     .to_vec();
-    let expected: Vec<u8> = [128u8, 100, 101, 0, 255, 255, 0, 0]
-        .iter()
-        .flat_map(|&v| [v; 3])
-        .collect();
+    let expected: Vec<u8> = [128u8, 100, 101, 0, 255, 255, 0, 0].iter().flat_map(|&v| [v; 3]).collect();
     for name in ["q.png", "q.ppm"] {
         let path = dir.path().join(name);
         write_image(&path, &film).unwrap();
@@ -122,10 +112,7 @@ fn write_replaces_an_existing_image_and_leaves_no_temporary() {
     let path = dir.path().join("out.png");
     write_image(&path, &Film::new(4, 4)).unwrap();
     write_image(&path, &level_film(3, 2)).unwrap();
-    assert_eq!(
-        read_rgb8(&path).unwrap(),
-        (3, 2, level_film(3, 2).to_rgb8())
-    );
+    assert_eq!(read_rgb8(&path).unwrap(), (3, 2, level_film(3, 2).to_rgb8()));
     assert_eq!(strays(dir.path(), &["out.png"]), Vec::<String>::new());
 }
 
@@ -134,9 +121,7 @@ fn write_unknown_extension_names_it_and_keeps_old_file() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("out.bmp");
     fs::write(&path, b"old contents").unwrap();
-    let err = write_image(&path, &level_film(2, 2))
-        .unwrap_err()
-        .to_string();
+    let err = write_image(&path, &level_film(2, 2)).unwrap_err().to_string();
     assert!(err.contains("\".bmp\""), "{err}");
     assert!(err.contains("png, ppm, exr"), "{err}");
     assert_eq!(fs::read(&path).unwrap(), b"old contents");
@@ -178,67 +163,38 @@ fn read_errors_name_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.png");
     let err = read_image(&missing).unwrap_err();
-    assert!(
-        err.is_io() && err.to_string().contains("missing.png"),
-        "{err}"
-    );
+    assert!(err.is_io() && err.to_string().contains("missing.png"), "{err}");
     let garbage = dir.path().join("garbage.png");
     fs::write(&garbage, b"\x89PNG\r\n\x1a\nnot really").unwrap();
     let err = read_rgb8(&garbage).unwrap_err();
-    assert!(
-        !err.is_io() && err.to_string().contains("garbage.png"),
-        "{err}"
-    );
+    assert!(!err.is_io() && err.to_string().contains("garbage.png"), "{err}");
 }
 
 #[test]
 fn read_converts_rgba_grey_and_16_bit() {
     let dir = tempfile::tempdir().unwrap();
     let rgba = dir.path().join("rgba.png");
-    image::RgbaImage::from_raw(2, 1, vec![10, 20, 30, 0, 40, 50, 60, 128])
-        .unwrap()
-        .save(&rgba)
-        .unwrap();
-    assert_eq!(
-        read_rgb8(&rgba).unwrap(),
-        (2, 1, vec![10, 20, 30, 40, 50, 60])
-    );
+    image::RgbaImage::from_raw(2, 1, vec![10, 20, 30, 0, 40, 50, 60, 128]).unwrap().save(&rgba).unwrap();
+    assert_eq!(read_rgb8(&rgba).unwrap(), (2, 1, vec![10, 20, 30, 40, 50, 60]));
 
     let grey = dir.path().join("grey.png");
-    image::GrayImage::from_raw(2, 1, vec![7, 200])
-        .unwrap()
-        .save(&grey)
-        .unwrap();
+    image::GrayImage::from_raw(2, 1, vec![7, 200]).unwrap().save(&grey).unwrap();
     assert_eq!(read_rgb8(&grey).unwrap().2, vec![7, 7, 7, 200, 200, 200]);
 
     let deep = dir.path().join("deep.png");
-    image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(1, 1, vec![0u16, 65535, 13107])
-        .unwrap()
-        .save(&deep)
-        .unwrap();
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(1, 1, vec![0u16, 65535, 13107]).unwrap().save(&deep).unwrap();
     let film = read_image(&deep).unwrap();
-    assert!(
-        (film.pixels[0] - Color::new(0.0, 1.0, 0.2))
-            .abs()
-            .max_element()
-            < 1e-6
-    );
+    assert!((film.pixels[0] - Color::new(0.0, 1.0, 0.2)).abs().max_element() < 1e-6);
 }
 
 #[test]
 fn compare_files_rgba_reference_equals_rgb_image() {
     let dir = tempfile::tempdir().unwrap();
     let reference = dir.path().join("ref.png");
-    image::RgbaImage::from_raw(2, 1, vec![10, 20, 30, 255, 40, 50, 60, 255])
-        .unwrap()
-        .save(&reference)
-        .unwrap();
+    image::RgbaImage::from_raw(2, 1, vec![10, 20, 30, 255, 40, 50, 60, 255]).unwrap().save(&reference).unwrap();
     let image = dir.path().join("image.ppm");
     let mut film = Film::new(2, 1);
-    film.pixels = vec![
-        Color::new(10.0, 20.0, 30.0) / 255.0,
-        Color::new(40.0, 50.0, 60.0) / 255.0,
-    ];
+    film.pixels = vec![Color::new(10.0, 20.0, 30.0) / 255.0, Color::new(40.0, 50.0, 60.0) / 255.0];
     write_image(&image, &film).unwrap();
     let c = compare_files(&reference, &image, 0).unwrap();
     assert!(c.identical() && c.psnr.is_infinite(), "{}", c.summary());
@@ -253,14 +209,7 @@ fn compare_files_size_mismatch_error_text() {
     write_image(&reference, &Film::new(8, 8)).unwrap();
     write_image(&image, &Film::new(6, 4)).unwrap();
     let err = compare_files(&reference, &image, 0).unwrap_err();
-    assert_eq!(
-        err.to_string(),
-        format!(
-            "{} is 6x4 but the reference {} is 8x8",
-            image.display(),
-            reference.display()
-        )
-    );
+    assert_eq!(err.to_string(), format!("{} is 6x4 but the reference {} is 8x8", image.display(), reference.display()));
 }
 
 #[test]
@@ -268,11 +217,7 @@ fn compare_files_counts_a_pixel_off_by_nine() {
     let dir = tempfile::tempdir().unwrap();
     let reference = dir.path().join("ref.png");
     let image = dir.path().join("image.png");
-    let film = Film {
-        width: 4,
-        height: 4,
-        pixels: vec![Color::splat(100.0 / 255.0); 16],
-    };
+    let film = Film { width: 4, height: 4, pixels: vec![Color::splat(100.0 / 255.0); 16] };
     let mut off = film.clone();
     off.pixels[5].z = 109.0 / 255.0;
     write_image(&reference, &film).unwrap();
@@ -284,11 +229,7 @@ fn compare_files_counts_a_pixel_off_by_nine() {
 }
 
 fn solid(size: u32, c: Color) -> Film {
-    Film {
-        width: size,
-        height: size,
-        pixels: vec![c; (size * size) as usize],
-    }
+    Film { width: size, height: size, pixels: vec![c; (size * size) as usize] }
 }
 
 #[test]
@@ -321,10 +262,7 @@ fn envmap_loads_cube_faces_by_any_naming_scheme() {
         ) / 255.0;
         let want = if name.ends_with(".exr") { c(v) } else { want };
         let got = map.eval(*axis);
-        assert!(
-            (got - want).abs().max_element() < 1e-6,
-            "{name}: {got} vs {want}"
-        );
+        assert!((got - want).abs().max_element() < 1e-6, "{name}: {got} vs {want}");
     }
 }
 
@@ -338,10 +276,7 @@ fn envmap_cube_directory_lists_missing_and_duplicate_faces() {
     let err = EnvMap::load(dir.path()).unwrap_err().to_string();
     assert_eq!(
         err,
-        format!(
-            "{}: cube map directory lacks faces -y (ny, negy, bottom); +z (pz, posz, front)",
-            dir.path().display()
-        )
+        format!("{}: cube map directory lacks faces -y (ny, negy, bottom); +z (pz, posz, front)", dir.path().display())
     );
     write_image(&dir.path().join("ny.png"), &solid(2, Color::ONE)).unwrap();
     write_image(&dir.path().join("front.png"), &solid(2, Color::ONE)).unwrap();
@@ -351,10 +286,7 @@ fn envmap_cube_directory_lists_missing_and_duplicate_faces() {
     fs::remove_file(dir.path().join("posz.exr")).unwrap();
     write_image(&dir.path().join("ny.png"), &solid(3, Color::ONE)).unwrap();
     let err = EnvMap::load(dir.path()).unwrap_err().to_string();
-    assert!(
-        err.contains("ny.png") && err.contains("is 3x3 but face +x is 2x2"),
-        "{err}"
-    );
+    assert!(err.contains("ny.png") && err.contains("is 3x3 but face +x is 2x2"), "{err}");
 }
 
 #[test]
@@ -382,27 +314,15 @@ fn envmap_loads_latlong_file_and_names_missing_one() {
 fn read_jpeg_and_radiance_hdr() {
     let dir = tempfile::tempdir().unwrap();
     let jpeg = dir.path().join("flat.JPG");
-    image::RgbImage::from_pixel(8, 8, image::Rgb([200, 100, 50]))
-        .save(&jpeg)
-        .unwrap();
+    image::RgbImage::from_pixel(8, 8, image::Rgb([200, 100, 50])).save(&jpeg).unwrap();
     let film = read_image(&jpeg).unwrap();
     let want = Color::new(200.0, 100.0, 50.0) / 255.0;
-    assert!(
-        (film.get(3, 3) - want).abs().max_element() < 4.0 / 255.0,
-        "{}",
-        film.get(3, 3)
-    );
+    assert!((film.get(3, 3) - want).abs().max_element() < 4.0 / 255.0, "{}", film.get(3, 3));
 
     let hdr = dir.path().join("bright.hdr");
-    image::Rgb32FImage::from_pixel(2, 2, image::Rgb([4.0, 0.5, 100.0]))
-        .save(&hdr)
-        .unwrap();
+    image::Rgb32FImage::from_pixel(2, 2, image::Rgb([4.0, 0.5, 100.0])).save(&hdr).unwrap();
     let film = read_image(&hdr).unwrap();
     let want = Color::new(4.0, 0.5, 100.0);
     // RGBE keeps 8 mantissa bits shared by the three channels.
-    assert!(
-        ((film.get(1, 1) - want) / want).abs().max_element() < 0.01,
-        "{}",
-        film.get(1, 1)
-    );
+    assert!(((film.get(1, 1) - want) / want).abs().max_element() < 0.01, "{}", film.get(1, 1));
 }

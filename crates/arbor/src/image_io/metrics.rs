@@ -60,19 +60,9 @@ impl Comparison {
 /// # Panics
 /// When a slice is not `width * height * 3` bytes long: that is a caller's bug, not bad input
 /// ([`compare_files`] checks sizes and reports them).
-pub fn compare_rgb8(
-    reference: &[u8],
-    image: &[u8],
-    width: u32,
-    height: u32,
-    threshold: u8,
-) -> Comparison {
+pub fn compare_rgb8(reference: &[u8], image: &[u8], width: u32, height: u32, threshold: u8) -> Comparison {
     let len = width as usize * height as usize * 3;
-    assert_eq!(
-        reference.len(),
-        len,
-        "reference is not {width}x{height} RGB"
-    );
+    assert_eq!(reference.len(), len, "reference is not {width}x{height} RGB");
     assert_eq!(image.len(), len, "image is not {width}x{height} RGB");
     let mut sum_sq = 0u64;
     let mut max_diff = 0u8;
@@ -88,27 +78,15 @@ pub fn compare_rgb8(
         pixels_off += usize::from(pixel_max > threshold);
     }
     let pixels = len / 3;
-    let mse = if len == 0 {
-        0.0
-    } else {
-        sum_sq as f64 / len as f64
-    };
+    let mse = if len == 0 { 0.0 } else { sum_sq as f64 / len as f64 };
     Comparison {
         width,
         height,
-        psnr: if mse == 0.0 {
-            f64::INFINITY
-        } else {
-            10.0 * (255.0 * 255.0 / mse).log10()
-        },
+        psnr: if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0 * 255.0 / mse).log10() },
         rmse: mse.sqrt(),
         max_diff,
         pixels_off,
-        share_off: if pixels == 0 {
-            0.0
-        } else {
-            pixels_off as f64 / pixels as f64
-        },
+        share_off: if pixels == 0 { 0.0 } else { pixels_off as f64 / pixels as f64 },
     }
 }
 
@@ -133,11 +111,7 @@ pub fn compare_files(reference: &Path, image: &Path, threshold: u8) -> Result<Co
 /// Under the same conditions as [`compare_rgb8`].
 pub fn diff_image(reference: &[u8], image: &[u8], width: u32, height: u32, gain: f32) -> Film {
     let len = width as usize * height as usize * 3;
-    assert_eq!(
-        reference.len(),
-        len,
-        "reference is not {width}x{height} RGB"
-    );
+    assert_eq!(reference.len(), len, "reference is not {width}x{height} RGB");
     assert_eq!(image.len(), len, "image is not {width}x{height} RGB");
     let level = |a: u8, b: u8| f32::from(a.abs_diff(b)) * gain / 255.0;
     let pixels = reference
@@ -145,11 +119,7 @@ pub fn diff_image(reference: &[u8], image: &[u8], width: u32, height: u32, gain:
         .zip(image.chunks_exact(3))
         .map(|(r, i)| Color::new(level(r[0], i[0]), level(r[1], i[1]), level(r[2], i[2])))
         .collect();
-    Film {
-        width,
-        height,
-        pixels,
-    }
+    Film { width, height, pixels }
 }
 
 #[cfg(test)]
@@ -165,10 +135,7 @@ mod tests {
         let a = grey(100, 12);
         let c = compare_rgb8(&a, &a, 4, 3, 0);
         assert!(c.psnr.is_infinite() && c.psnr > 0.0);
-        assert_eq!(
-            (c.rmse, c.max_diff, c.pixels_off, c.share_off),
-            (0.0, 0, 0, 0.0)
-        );
+        assert_eq!((c.rmse, c.max_diff, c.pixels_off, c.share_off), (0.0, 0, 0, 0.0));
         assert!(c.identical());
         assert!(c.summary().contains("PSNR inf"), "{}", c.summary());
     }
@@ -213,11 +180,6 @@ mod tests {
     fn diff_image_amplifies_absolute_difference() {
         let film = diff_image(&[10, 20, 30], &[20, 10, 30], 1, 1, 10.0);
         let expected = 100.0 / 255.0;
-        assert!(
-            (film.pixels[0] - Color::new(expected, expected, 0.0))
-                .abs()
-                .max_element()
-                < 1e-6
-        );
+        assert!((film.pixels[0] - Color::new(expected, expected, 0.0)).abs().max_element() < 1e-6);
     }
 }

@@ -16,16 +16,8 @@ use crate::math::Color;
 pub fn read_image(path: &Path) -> Result<Film> {
     let rgb = decode(path)?.into_rgb32f();
     let (width, height) = rgb.dimensions();
-    let pixels = rgb
-        .into_raw()
-        .chunks_exact(3)
-        .map(|c| Color::new(c[0], c[1], c[2]))
-        .collect();
-    Ok(Film {
-        width,
-        height,
-        pixels,
-    })
+    let pixels = rgb.into_raw().chunks_exact(3).map(|c| Color::new(c[0], c[1], c[2])).collect();
+    Ok(Film { width, height, pixels })
 }
 
 /// Reads an image as 8-bit RGB, row-major from the top: `(width, height, bytes)`. 16-bit samples are
@@ -37,14 +29,9 @@ pub fn read_rgb8(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 }
 
 fn decode(path: &Path) -> Result<DynamicImage> {
-    let reader = ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| Error::io(path, e))?;
+    let reader = ImageReader::open(path).and_then(|r| r.with_guessed_format()).map_err(|e| Error::io(path, e))?;
     reader.decode().map_err(|e| match e {
         image::ImageError::IoError(io) => Error::io(path, io),
-        other => Error::input(
-            Location::file(path),
-            format!("cannot decode image: {other}"),
-        ),
+        other => Error::input(Location::file(path), format!("cannot decode image: {other}")),
     })
 }

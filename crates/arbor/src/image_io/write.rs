@@ -45,16 +45,12 @@ pub fn write_image(path: &Path, film: &Film) -> Result<()> {
             film.pixels.len()
         )));
     }
-    let bytes = encode(film, format)
-        .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
+    let bytes = encode(film, format).map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
     write_atomic(path, &bytes)
 }
 
 fn format_of(path: &Path) -> Result<Format> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("png") => Ok(Format::Png),
         Some("ppm") => Ok(Format::Ppm),
@@ -77,19 +73,15 @@ fn encode(film: &Film, format: Format) -> image::ImageResult<Vec<u8>> {
     let (w, h) = (film.width, film.height);
     let mut out = Cursor::new(Vec::new());
     match format {
-        Format::Png => {
-            PngEncoder::new(&mut out).write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?
-        }
-        Format::Ppm => PnmEncoder::new(&mut out)
-            .with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary))
-            .write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?,
+        Format::Png => PngEncoder::new(&mut out).write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?,
+        Format::Ppm => PnmEncoder::new(&mut out).with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary)).write_image(
+            &film.to_rgb8(),
+            w,
+            h,
+            ExtendedColorType::Rgb8,
+        )?,
         Format::Exr => {
-            let bytes: Vec<u8> = film
-                .pixels
-                .iter()
-                .flat_map(|c| c.to_array())
-                .flat_map(f32::to_ne_bytes)
-                .collect();
+            let bytes: Vec<u8> = film.pixels.iter().flat_map(|c| c.to_array()).flat_map(f32::to_ne_bytes).collect();
             OpenExrEncoder::new(&mut out).write_image(&bytes, w, h, ExtendedColorType::Rgb32F)?
         }
     }
@@ -104,10 +96,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     };
     fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let (tmp, mut file) = create_temp(&dir, path)?;
-    let written = file
-        .write_all(bytes)
-        .and_then(|()| file.sync_all())
-        .map_err(|e| Error::io(&tmp, e));
+    let written = file.write_all(bytes).and_then(|()| file.sync_all()).map_err(|e| Error::io(&tmp, e));
     drop(file);
     let renamed = written.and_then(|()| fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
     if renamed.is_err() {
@@ -120,18 +109,11 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// A new file named after the target, unique per process and call, so parallel writers never share one.
 fn create_temp(dir: &Path, target: &Path) -> Result<(PathBuf, fs::File)> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "image".to_string());
+    let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "image".to_string());
     loop {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
-        match fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
+        match fs::OpenOptions::new().write(true).create_new(true).open(&tmp) {
             Ok(f) => return Ok((tmp, f)),
             // A leftover from a killed run with the same pid: take the next number.
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,

@@ -59,9 +59,7 @@ const FACE_NAMES: [[&str; 3]; 6] = [
 ];
 
 /// Extensions of files considered as faces; anything else in the directory is ignored.
-const IMAGE_EXTENSIONS: [&str; 9] = [
-    "png", "jpg", "jpeg", "ppm", "pgm", "pnm", "exr", "hdr", "pfm",
-];
+const IMAGE_EXTENSIONS: [&str; 9] = ["png", "jpg", "jpeg", "ppm", "pgm", "pnm", "exr", "hdr", "pfm"];
 
 /// Radiance from infinitely far away, by direction. See the module documentation for the conventions.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,10 +88,7 @@ impl EnvMap {
         }
         let film = read_image(spec)?;
         if film.pixels.is_empty() {
-            return Err(Error::input(
-                Location::file(spec),
-                "the environment map is empty",
-            ));
+            return Err(Error::input(Location::file(spec), "the environment map is empty"));
         }
         Ok(EnvMap::from_film_latlong(film))
     }
@@ -107,17 +102,13 @@ impl EnvMap {
             film.width > 0 && film.pixels.len() == film.width as usize * film.height as usize,
             "latitude-longitude film must be non-empty and consistent"
         );
-        EnvMap {
-            kind: Kind::LatLong(film),
-        }
+        EnvMap { kind: Kind::LatLong(film) }
     }
 
     /// A cube map from six faces in the order `+x -x +y -y +z -z` ([`FACE_LABELS`]). The faces must be
     /// square, non-empty and of one size.
     pub fn from_faces(faces: [Film; 6]) -> Result<EnvMap> {
-        check_faces(&faces).map_err(|(face, msg)| {
-            Error::Invalid(format!("cube face {}: {msg}", FACE_LABELS[face]))
-        })?;
+        check_faces(&faces).map_err(|(face, msg)| Error::Invalid(format!("cube face {}: {msg}", FACE_LABELS[face])))?;
         Ok(cube(faces))
     }
 
@@ -139,12 +130,7 @@ impl EnvMap {
 }
 
 fn cube(faces: [Film; 6]) -> EnvMap {
-    EnvMap {
-        kind: Kind::Cube {
-            size: faces[0].width,
-            faces: Box::new(faces),
-        },
-    }
+    EnvMap { kind: Kind::Cube { size: faces[0].width, faces: Box::new(faces) } }
 }
 
 /// The first face that is not square, empty, inconsistent or of another size than face 0.
@@ -152,25 +138,13 @@ fn check_faces(faces: &[Film; 6]) -> std::result::Result<(), (usize, String)> {
     let size = faces[0].width;
     for (i, f) in faces.iter().enumerate() {
         if f.pixels.len() != f.width as usize * f.height as usize {
-            return Err((
-                i,
-                format!("{}x{} but {} pixels", f.width, f.height, f.pixels.len()),
-            ));
+            return Err((i, format!("{}x{} but {} pixels", f.width, f.height, f.pixels.len())));
         }
         if f.width != f.height || f.width == 0 {
-            return Err((
-                i,
-                format!(
-                    "faces must be square and non-empty, this one is {}x{}",
-                    f.width, f.height
-                ),
-            ));
+            return Err((i, format!("faces must be square and non-empty, this one is {}x{}", f.width, f.height)));
         }
         if f.width != size {
-            return Err((
-                i,
-                format!("is {0}x{0} but face +x is {size}x{size}", f.width),
-            ));
+            return Err((i, format!("is {0}x{0} but face +x is {size}x{size}", f.width)));
         }
     }
     Ok(())
@@ -185,28 +159,17 @@ fn find_faces(dir: &Path) -> Result<[PathBuf; 6]> {
         let (Some(stem), Some(ext)) = (path.file_stem(), path.extension()) else {
             continue;
         };
-        let (stem, ext) = (
-            stem.to_string_lossy().to_lowercase(),
-            ext.to_string_lossy().to_lowercase(),
-        );
+        let (stem, ext) = (stem.to_string_lossy().to_lowercase(), ext.to_string_lossy().to_lowercase());
         if !IMAGE_EXTENSIONS.contains(&ext.as_str()) {
             continue;
         }
-        let Some(face) = FACE_NAMES
-            .iter()
-            .position(|names| names.contains(&stem.as_str()))
-        else {
+        let Some(face) = FACE_NAMES.iter().position(|names| names.contains(&stem.as_str())) else {
             continue;
         };
         if let Some(other) = &found[face] {
             return Err(Error::input(
                 Location::file(dir),
-                format!(
-                    "two files for cube face {}: {} and {}",
-                    FACE_LABELS[face],
-                    file_name(other),
-                    file_name(&path)
-                ),
+                format!("two files for cube face {}: {} and {}", FACE_LABELS[face], file_name(other), file_name(&path)),
             ));
         }
         found[face] = Some(path);
@@ -218,16 +181,11 @@ fn find_faces(dir: &Path) -> Result<[PathBuf; 6]> {
         .filter(|&i| found[i].is_none())
         .map(|i| format!("{} ({})", FACE_LABELS[i], FACE_NAMES[i].join(", ")))
         .collect();
-    Err(Error::input(
-        Location::file(dir),
-        format!("cube map directory lacks faces {}", missing.join("; ")),
-    ))
+    Err(Error::input(Location::file(dir), format!("cube map directory lacks faces {}", missing.join("; "))))
 }
 
 fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
+    path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 fn eval_latlong(film: &Film, dir: Vec3) -> Color {
@@ -243,10 +201,7 @@ fn eval_latlong(film: &Film, dir: Vec3) -> Color {
     // Wrap in longitude; clamp at the poles, where a row is a single point.
     let px = |i: i64| i.rem_euclid(w) as u32;
     let py = |j: i64| j.clamp(0, h - 1) as u32;
-    let row = |j: i64| {
-        film.get(px(x0), py(j))
-            .lerp(film.get(px(x0 + 1), py(j)), fx)
-    };
+    let row = |j: i64| film.get(px(x0), py(j)).lerp(film.get(px(x0 + 1), py(j)), fx);
     row(y0).lerp(row(y0 + 1), fy)
 }
 
@@ -296,14 +251,8 @@ fn eval_cube(faces: &[Film; 6], size: u32, dir: Vec3) -> Color {
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let cube = Cube {
-        faces,
-        size: size as i64,
-    };
-    let row = |j: i64| {
-        cube.fetch(face, x0, j)
-            .lerp(cube.fetch(face, x0 + 1, j), fx)
-    };
+    let cube = Cube { faces, size: size as i64 };
+    let row = |j: i64| cube.fetch(face, x0, j).lerp(cube.fetch(face, x0 + 1, j), fx);
     row(y0).lerp(row(y0 + 1), fy)
 }
 
@@ -321,9 +270,7 @@ impl Cube<'_> {
         match (inside(i), inside(j)) {
             (true, true) => self.texel(face, i, j),
             (false, false) => {
-                (self.across(face, clamp(i), j)
-                    + self.across(face, i, clamp(j))
-                    + self.texel(face, clamp(i), clamp(j)))
+                (self.across(face, clamp(i), j) + self.across(face, i, clamp(j)) + self.texel(face, clamp(i), clamp(j)))
                     / 3.0
             }
             _ => self.across(face, i, j),
@@ -341,19 +288,12 @@ impl Cube<'_> {
         let centre = |k: i64| (2 * k + 1) as f32 / n - 1.0;
         let edge = |k: i64| if k < 0 { -1.0 } else { 1.0 };
         let outside = |k: i64| !(0..self.size).contains(&k);
-        let (sc, tc) = (
-            if outside(i) { edge(i) } else { centre(i) },
-            if outside(j) { edge(j) } else { centre(j) },
-        );
+        let (sc, tc) = (if outside(i) { edge(i) } else { centre(i) }, if outside(j) { edge(j) } else { centre(j) });
         // On the shared edge both faces tie for the major axis; pushing the point a little past the edge
         // picks the neighbour. Its coordinates come from the exact edge point so the texel along the edge
         // is found at its centre, far from any rounding boundary.
         let on_edge = face_point(face, sc, tc);
-        let beyond = face_point(
-            face,
-            if outside(i) { sc * 1.01 } else { sc },
-            if outside(j) { tc * 1.01 } else { tc },
-        );
+        let beyond = face_point(face, if outside(i) { sc * 1.01 } else { sc }, if outside(j) { tc * 1.01 } else { tc });
         let next = major_face(beyond);
         let (nsc, ntc, nma) = face_coords(next, on_edge);
         let index = |c: f32| (((c / nma + 1.0) * 0.5 * n).floor() as i64).clamp(0, self.size - 1);
@@ -402,14 +342,7 @@ mod tests {
     #[test]
     fn latlong_axes_hit_expected_pixels() {
         let map = axis_latlong();
-        let cases = [
-            (Vec3::X, PX),
-            (-Vec3::X, NX),
-            (Vec3::Y, PY),
-            (-Vec3::Y, NY),
-            (Vec3::Z, PZ),
-            (-Vec3::Z, NZ),
-        ];
+        let cases = [(Vec3::X, PX), (-Vec3::X, NX), (Vec3::Y, PY), (-Vec3::Y, NY), (Vec3::Z, PZ), (-Vec3::Z, NZ)];
         for (dir, want) in cases {
             assert_eq!(map.eval(dir * 3.0), want, "direction {dir}");
         }
@@ -444,14 +377,7 @@ mod tests {
     fn cube_axes_return_their_face_colour() {
         let map = EnvMap::from_faces(solid_faces(4)).unwrap();
         assert!(map.is_cube_map());
-        let cases = [
-            (Vec3::X, PX),
-            (-Vec3::X, NX),
-            (Vec3::Y, PY),
-            (-Vec3::Y, NY),
-            (Vec3::Z, PZ),
-            (-Vec3::Z, NZ),
-        ];
+        let cases = [(Vec3::X, PX), (-Vec3::X, NX), (Vec3::Y, PY), (-Vec3::Y, NY), (Vec3::Z, PZ), (-Vec3::Z, NZ)];
         for (dir, want) in cases {
             assert_eq!(map.eval(dir * 0.5), want, "direction {dir}");
         }
@@ -465,12 +391,12 @@ mod tests {
         let faces: [Film; 6] = std::array::from_fn(|f| film(2, 2, |x, y| code(f, x, y)));
         let map = EnvMap::from_faces(faces).unwrap();
         let cases = [
-            (Vec3::new(1.0, 0.5, -0.5), 0, 1, 0), // +x: sc = -z = 0.5, tc = -y = -0.5
+            (Vec3::new(1.0, 0.5, -0.5), 0, 1, 0),  // +x: sc = -z = 0.5, tc = -y = -0.5
             (Vec3::new(-1.0, 0.5, -0.5), 1, 0, 0), // -x: sc = z = -0.5, tc = -y = -0.5
-            (Vec3::new(0.5, 1.0, 0.5), 2, 1, 1),  // +y: sc = x = 0.5, tc = z = 0.5
-            (Vec3::new(0.5, -1.0, 0.5), 3, 1, 0), // -y: sc = x = 0.5, tc = -z = -0.5
+            (Vec3::new(0.5, 1.0, 0.5), 2, 1, 1),   // +y: sc = x = 0.5, tc = z = 0.5
+            (Vec3::new(0.5, -1.0, 0.5), 3, 1, 0),  // -y: sc = x = 0.5, tc = -z = -0.5
             (Vec3::new(-0.5, -0.5, 1.0), 4, 0, 1), // +z: sc = x = -0.5, tc = -y = 0.5
-            (Vec3::new(0.5, 0.5, -1.0), 5, 0, 0), // -z: sc = -x = -0.5, tc = -y = -0.5
+            (Vec3::new(0.5, 0.5, -1.0), 5, 0, 0),  // -z: sc = -x = -0.5, tc = -y = -0.5
         ];
         for (d, face, x, y) in cases {
             assert_eq!(map.eval(d * 2.0), code(face, x, y), "direction {d}");
@@ -502,11 +428,7 @@ mod tests {
             Vec3::new(-0.6, 0.25, -1.0),
         ] {
             let want = 0.5 + 0.5 * d.normalize();
-            assert!(
-                close(map.eval(d), want, 0.03),
-                "{d}: {} vs {want}",
-                map.eval(d)
-            );
+            assert!(close(map.eval(d), want, 0.03), "{d}: {} vs {want}", map.eval(d));
         }
     }
 
@@ -519,22 +441,10 @@ mod tests {
             (Vec3::new(1.0, 0.3, 1.0 - e), Vec3::new(1.0 - e, 0.3, 1.0)), // +x | +z
             (Vec3::new(1.0, 0.7, -1.0 + e), Vec3::new(1.0 - e, 0.7, -1.0)), // +x | -z
             (Vec3::new(-0.2, 1.0, 1.0 - e), Vec3::new(-0.2, 1.0 - e, 1.0)), // +y | +z
-            (
-                Vec3::new(-1.0, -1.0 + e, 0.6),
-                Vec3::new(-1.0 + e, -1.0, 0.6),
-            ), // -x | -y
-            (
-                Vec3::new(0.9, -1.0, -1.0 + e),
-                Vec3::new(0.9, -1.0 + e, -1.0),
-            ), // -y | -z
-            (
-                Vec3::new(1.0, 1.0 - e, 1.0 - e),
-                Vec3::new(1.0 - e, 1.0, 1.0 - e),
-            ), // corner +x +y +z
-            (
-                Vec3::new(1.0 - e, 1.0 - e, 1.0),
-                Vec3::new(1.0, 1.0 - e, 1.0 - e),
-            ),
+            (Vec3::new(-1.0, -1.0 + e, 0.6), Vec3::new(-1.0 + e, -1.0, 0.6)), // -x | -y
+            (Vec3::new(0.9, -1.0, -1.0 + e), Vec3::new(0.9, -1.0 + e, -1.0)), // -y | -z
+            (Vec3::new(1.0, 1.0 - e, 1.0 - e), Vec3::new(1.0 - e, 1.0, 1.0 - e)), // corner +x +y +z
+            (Vec3::new(1.0 - e, 1.0 - e, 1.0), Vec3::new(1.0, 1.0 - e, 1.0 - e)),
         ];
         for (a, b) in pairs {
             let (ca, cb) = (map.eval(a), map.eval(b));
@@ -551,9 +461,6 @@ mod tests {
         let mut faces = solid_faces(4);
         faces[5] = film(2, 2, |_, _| NZ);
         let err = EnvMap::from_faces(faces).unwrap_err().to_string();
-        assert!(
-            err.contains("cube face -z") && err.contains("is 2x2 but face +x is 4x4"),
-            "{err}"
-        );
+        assert!(err.contains("cube face -z") && err.contains("is 2x2 but face +x is 4x4"), "{err}");
     }
 }
