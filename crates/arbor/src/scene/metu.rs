@@ -1,8 +1,525 @@
-//! (being written)
-use super::{tree::Node, SceneDesc};
-pub fn read(_root: &Node, path: &std::path::Path) -> crate::Result<SceneDesc> {
-    Err(crate::Error::Invalid(format!(
-        "{}: METU reader not written yet",
-        path.display()
-    )))
+//! The METU CENG 795 scene schema (XML, and the 2025 JSON form of it), read from the element tree into
+//! a [`SceneDesc`]. The schema, its defaults and its quirks are described in `shared/scenes/README.md`
+//! section (ii); the rules that matter here:
+//!
+//! - ids are 1-based and per kind; materials become indices, inline meshes are compacted to the
+//!   vertices they use (0-based), a sphere's `Center` and a plane's `Point` are vertex ids;
+//! - `Transformations` lists named transforms (`t1 s2 r1 c1`) applied left to right;
+//! - a look-at camera's window is `top = NearDistance·tan(FovY/2)`, `right = top·width/height`;
+//! - untyped (pre-2020) materials: a non-zero `Transparency` means glass, else a non-zero
+//!   `MirrorReflectance` means a mirror;
+//! - duplicated single-valued elements: the last one wins, with a warning;
+//! - what Arbor does not render (textures, motion blur, BRDFs, tone mapping...) is one warning per
+//!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use super::tree::{Node, Unused};
+use super::{CameraDesc, Lens, LightDesc, MaterialDesc, MaterialKind, SceneDesc, Window};
+use crate::math::{Color, Mat4, Transform, Vec3};
+use crate::{Error, Location, Result};
+
+/// Reads the scene below the root element `root` of the file `path`.
+pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
+    if root.name != "Scene" {
+        return Err(Error::input(
+            root.loc(path),
+            format!("root element is <{}>, expected <Scene>", root.name),
+        ));
+    }
+    root.mark_used();
+    let mut r = Reader {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        desc: SceneDesc::new(path),
+        notes: Notes::default(),
+        vertices: Vec::new(),
+        transforms: HashMap::new(),
+        materials: HashMap::new(),
+    };
+    r.globals(root)?;
+    if let Some(v) = r.one(root, "VertexData") {
+        r.vertices = vertex_data(v, path)?;
+    }
+    if let Some(t) = r.one(root, "Transformations") {
+        r.transformations(t)?;
+    }
+    if let Some(m) = r.one(root, "Materials") {
+        r.read_materials(m)?;
+    }
+    if let Some(c) = r.one(root, "Cameras") {
+        for (i, cam) in c.all("Camera").enumerate() {
+            let cam = r.camera(cam, i)?;
+            r.desc.cameras.push(cam);
+        }
+    }
+    if let Some(l) = r.one(root, "Lights") {
+        r.lights(l)?;
+    }
+    if let Some(o) = r.one(root, "Objects") {
+        r.objects(o)?;
+    }
+    for u in root.unused() {
+        match u {
+            Unused::Element(n, parent) => r.notes.plain(
+                n.loc(path),
+                format!(
+                    "<{}> in <{parent}> ignored (unknown or unused here)",
+                    n.name
+                ),
+            ),
+            Unused::Attr(a, elem) => r.notes.plain(
+                a.loc(path),
+                format!(
+                    "attribute {} of <{elem}> ignored (unknown or unused here)",
+                    a.name
+                ),
+            ),
+        }
+    }
+    r.desc.warnings = r.notes.finish();
+    Ok(r.desc)
 }
+
+/// Warnings in file-reading order; an unsupported feature is one line however often it occurs.
+#[derive(Default)]
+struct Notes {
+    lines: Vec<(String, usize)>,
+    features: HashMap<String, usize>,
+}
+
+impl Notes {
+    fn plain(&mut self, loc: Location, msg: String) {
+        self.lines.push((format!("{loc}: {msg}"), 1));
+    }
+    fn feature(&mut self, loc: Location, name: &str, what: &str) {
+        if let Some(&i) = self.features.get(name) {
+            self.lines[i].1 += 1;
+            return;
+        }
+        self.features.insert(name.to_string(), self.lines.len());
+        self.lines
+            .push((format!("{loc}: <{name}> ignored: {what} not supported"), 1));
+    }
+    fn finish(self) -> Vec<String> {
+        let times = |(s, n): (String, usize)| match n {
+            1 => s,
+            n => format!("{s} ({n} occurrences)"),
+        };
+        self.lines.into_iter().map(times).collect()
+    }
+}
+
+struct Reader<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+    desc: SceneDesc,
+    notes: Notes,
+    vertices: Vec<Vec3>,
+    transforms: HashMap<String, Transform>,
+    materials: HashMap<String, usize>,
+}
+
+fn vertex_data(v: &Node, path: &Path) -> Result<Vec<Vec3>> {
+    if let Some(t) = v.attr("type") {
+        if t.trimmed() != "xyz" {
+            let msg = format!(
+                "<VertexData>: unknown type '{}' (expected xyz)",
+                t.trimmed()
+            );
+            return Err(Error::input(t.loc(path), msg));
+        }
+    }
+    let f = v.floats(path)?;
+    if f.len() % 3 != 0 {
+        let msg = format!(
+            "<VertexData>: expected x y z triples, found {} numbers",
+            f.len()
+        );
+        return Err(Error::input(v.loc(path), msg));
+    }
+    Ok(f.chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+impl Reader<'_> {
+    fn err(&self, n: &Node, msg: impl Into<String>) -> Error {
+        Error::input(n.loc(self.path), msg)
+    }
+
+    /// The child `name` of `parent`, warning about duplicates (the last one wins).
+    fn one<'n>(&mut self, parent: &'n Node, name: &str) -> Option<&'n Node> {
+        for d in parent.duplicates(name) {
+            let msg = format!("duplicate <{name}> in <{}>; the last one wins", parent.name);
+            self.notes.plain(d.loc(self.path), msg);
+        }
+        parent.child(name)
+    }
+
+    fn req<'n>(&mut self, parent: &'n Node, name: &str) -> Result<&'n Node> {
+        self.one(parent, name);
+        parent.required(name, self.path)
+    }
+
+    /// Reports every `name` child of `parent` as an unsupported feature and marks it read.
+    fn unsupported(&mut self, parent: &Node, name: &str, what: &str) {
+        for n in parent.all(name) {
+            n.mark_subtree_used();
+            self.notes.feature(n.loc(self.path), name, what);
+        }
+    }
+
+    fn globals(&mut self, root: &Node) -> Result<()> {
+        let p = self.path;
+        if let Some(n) = self.one(root, "BackgroundColor") {
+            self.desc.background = n.vec3(p)?;
+        }
+        if let Some(n) = self.one(root, "ShadowRayEpsilon") {
+            self.desc.shadow_epsilon = n.float(p)?;
+        }
+        if let Some(n) = self.one(root, "IntersectionTestEpsilon") {
+            self.desc.intersection_epsilon = n.float(p)?;
+        }
+        if let Some(n) = self.one(root, "MaxRecursionDepth") {
+            self.desc.max_depth = n.uint(p)?;
+        }
+        if let Some(n) = self.one(root, "BackfaceCulling") {
+            self.desc.cull_backfaces = Some(n.boolean(p)?);
+        }
+        if let Some(n) = self.one(root, "TexCoordData") {
+            // Read for its syntax only: nothing Arbor renders uses texture coordinates.
+            n.floats(p)?;
+        }
+        self.unsupported(root, "Textures", "textures are");
+        self.unsupported(root, "BackgroundTexture", "background textures are");
+        self.unsupported(root, "BRDFs", "BRDF models are");
+        Ok(())
+    }
+
+    fn transformations(&mut self, t: &Node) -> Result<()> {
+        let p = self.path;
+        for n in &t.children {
+            let prefix = match n.name.as_str() {
+                "Translation" => "t",
+                "Scaling" => "s",
+                "Rotation" => "r",
+                "Composite" => "c",
+                _ => continue,
+            };
+            n.mark_used();
+            let id = n
+                .attr("id")
+                .ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
+            let made = match prefix {
+                "t" => Some(Transform::translate(n.vec3(p)?)),
+                "s" => Transform::scale(n.vec3(p)?),
+                "r" => {
+                    let v = n.floats_n(4, false, p)?;
+                    Transform::rotate(v[0], Vec3::new(v[1], v[2], v[3]))
+                }
+                _ => {
+                    let v = n.floats_n(16, false, p)?;
+                    let rows: [f32; 16] = v.try_into().unwrap_or([0.0; 16]);
+                    Transform::from_mat4(Mat4::from_cols_array(&rows).transpose())
+                }
+            };
+            let made = made.ok_or_else(|| {
+                self.err(
+                    n,
+                    format!(
+                        "<{}>: degenerate transformation (zero scale or axis)",
+                        n.name
+                    ),
+                )
+            })?;
+            let key = format!("{prefix}{}", id.trimmed());
+            if self.transforms.insert(key.clone(), made).is_some() {
+                return Err(self.err(n, format!("duplicate transformation '{key}'")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The `Transformations` child of `n`, composed left to right; identity when absent.
+    fn transform_of(&mut self, n: &Node) -> Result<Transform> {
+        let Some(list) = self.one(n, "Transformations") else {
+            return Ok(Transform::IDENTITY);
+        };
+        let mut acc = Transform::IDENTITY;
+        for name in list.trimmed().split_whitespace() {
+            let t = self.transforms.get(name).ok_or_else(|| {
+                self.err(
+                    list,
+                    format!("<Transformations>: unknown transformation '{name}'"),
+                )
+            })?;
+            // The first listed is applied first (README (ii), "Mesh/Transformations").
+            acc = acc.then(t);
+        }
+        Ok(acc)
+    }
+
+    fn camera(&mut self, c: &Node, index: usize) -> Result<CameraDesc> {
+        let p = self.path;
+        let id = c
+            .attr("id")
+            .map_or_else(|| (index + 1).to_string(), |a| a.trimmed().to_string());
+        let look_at = match c.attr("type").map(|a| (a, a.trimmed())) {
+            None => false,
+            Some((_, "lookAt")) => true,
+            Some((a, other)) => {
+                let msg = format!("Camera {id}: unknown type '{other}' (expected lookAt)");
+                return Err(Error::input(a.loc(p), msg));
+            }
+        };
+        if let Some(h) = c.attr("handedness").filter(|h| h.trimmed() != "right") {
+            let msg = format!(
+                "Camera {id}: handedness '{}' not supported; right-handed used",
+                h.trimmed()
+            );
+            self.notes.plain(h.loc(p), msg);
+        }
+        let position = self.req(c, "Position")?.vec3(p)?;
+        let up = self.req(c, "Up")?.vec3(p)?;
+        let near_distance = self.req(c, "NearDistance")?.float(p)?;
+        let res_node = self.req(c, "ImageResolution")?;
+        let res = res_node.ints(p)?;
+        let (width, height) = match res[..] {
+            [w, h] if w > 0 && h > 0 && w <= u32::MAX as i64 && h <= u32::MAX as i64 => {
+                (w as u32, h as u32)
+            }
+            _ => {
+                return Err(self.err(
+                    res_node,
+                    "<ImageResolution>: expected two positive integers",
+                ))
+            }
+        };
+        let image_name = self.req(c, "ImageName")?.trimmed().to_string();
+        let num_samples = match self.one(c, "NumSamples") {
+            Some(n) => n.uint(p)?.max(1),
+            None => 1,
+        };
+        let (gaze, window) = if look_at {
+            let gaze = match self.one(c, "GazePoint") {
+                Some(g) => g.vec3(p)? - position,
+                None => self.req(c, "Gaze")?.vec3(p)?,
+            };
+            let fov_deg = self.req(c, "FovY")?.float(p)?;
+            let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
+            let right = top * width as f32 / height as f32;
+            (
+                gaze,
+                Window {
+                    left: -right,
+                    right,
+                    bottom: -top,
+                    top,
+                },
+            )
+        } else {
+            let gaze = self.req(c, "Gaze")?.vec3(p)?;
+            let np = self.req(c, "NearPlane")?;
+            let v = np.floats_n(4, true, p)?;
+            let extra = np.trimmed().split_whitespace().count();
+            if extra > 4 {
+                let msg = format!("<NearPlane> has {extra} numbers; only the first 4 are used");
+                self.notes.plain(np.loc(p), msg);
+            }
+            (
+                gaze,
+                Window {
+                    left: v[0],
+                    right: v[1],
+                    bottom: v[2],
+                    top: v[3],
+                },
+            )
+        };
+        if gaze.length_squared() == 0.0 {
+            return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
+        }
+        let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
+            (None, None) => None,
+            (Some(f), Some(a)) => Some(Lens {
+                aperture: a.float(p)?,
+                focus_distance: f.float(p)?,
+            }),
+            (Some(_), None) => return Err(self.err(c, "<Camera>: missing <ApertureSize>")),
+            (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
+        };
+        let transform = self.transform_of(c)?;
+        self.unsupported(c, "Tonemap", "tone mapping is");
+        self.unsupported(c, "Renderer", "path tracing is");
+        self.unsupported(c, "RendererParams", "path tracing is");
+        Ok(CameraDesc {
+            id,
+            position,
+            gaze,
+            up,
+            window,
+            near_distance,
+            orthographic: false,
+            width,
+            height,
+            image_name,
+            num_samples,
+            transform,
+            lens,
+            loc: c.loc(p),
+        })
+    }
+
+    fn lights(&mut self, l: &Node) -> Result<()> {
+        let p = self.path;
+        if let Some(a) = self.one(l, "AmbientLight") {
+            self.desc.ambient = a.vec3(p)?;
+        }
+        for n in &l.children {
+            let light = match n.name.as_str() {
+                "PointLight" => LightDesc::Point {
+                    position: self.req(n, "Position")?.vec3(p)?,
+                    intensity: self.req(n, "Intensity")?.vec3(p)?,
+                },
+                "AreaLight" => LightDesc::Area {
+                    position: self.req(n, "Position")?.vec3(p)?,
+                    normal: self.unit(n, "Normal")?,
+                    size: self.req(n, "Size")?.float(p)?,
+                    radiance: self.req(n, "Radiance")?.vec3(p)?,
+                },
+                "DirectionalLight" => LightDesc::Directional {
+                    direction: self.unit(n, "Direction")?,
+                    radiance: self.req(n, "Radiance")?.vec3(p)?,
+                },
+                "SphericalDirectionalLight" => {
+                    let name = self.req(n, "EnvMapName")?.trimmed();
+                    if self.desc.environment.is_some() {
+                        let msg = "duplicate environment light; the last one wins".to_string();
+                        self.notes.plain(n.loc(p), msg);
+                    }
+                    self.desc.environment = Some(self.dir.join(name));
+                    n.mark_used();
+                    n.attr("id");
+                    continue;
+                }
+                _ => continue,
+            };
+            n.mark_used();
+            n.attr("id");
+            self.desc.lights.push(light);
+        }
+        self.unsupported(l, "SpotLight", "spot lights are");
+        Ok(())
+    }
+
+    /// The child `name` of `n` as a unit vector.
+    fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
+        let c = self.req(n, name)?;
+        let v = c.vec3(self.path)?;
+        v.try_normalize()
+            .ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
+    }
+
+    fn read_materials(&mut self, ms: &Node) -> Result<()> {
+        for (i, m) in ms.all("Material").enumerate() {
+            let id = m
+                .attr("id")
+                .map_or_else(|| (i + 1).to_string(), |a| a.trimmed().to_string());
+            let mat = self.material(m, id.clone())?;
+            if self
+                .materials
+                .insert(id.clone(), self.desc.materials.len())
+                .is_some()
+            {
+                return Err(self.err(m, format!("duplicate material id '{id}'")));
+            }
+            self.desc.materials.push(mat);
+        }
+        Ok(())
+    }
+
+    fn material(&mut self, m: &Node, id: String) -> Result<MaterialDesc> {
+        let p = self.path;
+        let color = |r: &mut Self, name: &str| -> Result<Option<Color>> {
+            r.one(m, name).map(|n| n.vec3(p)).transpose()
+        };
+        let ambient = self.req(m, "AmbientReflectance")?.vec3(p)?;
+        let diffuse = self.req(m, "DiffuseReflectance")?.vec3(p)?;
+        let specular = color(self, "SpecularReflectance")?.unwrap_or(Color::ZERO);
+        let phong_exponent = match self.one(m, "PhongExponent") {
+            Some(n) => n.float(p)?,
+            None => 1.0,
+        };
+        let float = |r: &mut Self, name: &str| -> Result<f32> { r.req(m, name)?.float(p) };
+        let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
+            Some((_, t)) if t == "mirror" => MaterialKind::Mirror {
+                reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
+            },
+            Some((_, t)) if t == "conductor" => MaterialKind::Conductor {
+                reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
+                eta: float(self, "RefractionIndex")?,
+                k: float(self, "AbsorptionIndex")?,
+            },
+            Some((_, t)) if t == "dielectric" => MaterialKind::Dielectric {
+                eta: float(self, "RefractionIndex")?,
+                absorption: color(self, "AbsorptionCoefficient")?.unwrap_or(Color::ZERO),
+            },
+            Some((a, t)) => {
+                let msg = format!(
+                    "Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)"
+                );
+                return Err(Error::input(a.loc(p), msg));
+            }
+            None => {
+                // Pre-2020 files have no type; the elements present say what the material is.
+                let mirror = color(self, "MirrorReflectance")?.unwrap_or(Color::ZERO);
+                let transparency = color(self, "Transparency")?.unwrap_or(Color::ZERO);
+                if transparency != Color::ZERO {
+                    let eta = float(self, "RefractionIndex")?;
+                    MaterialKind::Transparent {
+                        eta,
+                        transparency,
+                        mirror,
+                    }
+                } else if mirror != Color::ZERO {
+                    MaterialKind::Mirror {
+                        reflectance: mirror,
+                    }
+                } else {
+                    MaterialKind::BlinnPhong
+                }
+            }
+        };
+        if let Some(a) = m.attr("BRDF") {
+            self.notes
+                .feature(a.loc(p), "Material BRDF=", "BRDF models are");
+        }
+        if let Some(a) = m.attr("degamma") {
+            self.notes
+                .feature(a.loc(p), "Material degamma=", "degamma is");
+        }
+        self.unsupported(m, "Roughness", "glossy reflection is");
+        Ok(MaterialDesc {
+            id,
+            ambient,
+            diffuse,
+            specular,
+            phong_exponent,
+            kind,
+        })
+    }
+
+    /// The material an object names, as an index.
+    fn material_of(&mut self, o: &Node, name: &str) -> Result<usize> {
+        let m = self.req(o, "Material")?;
+        let id = m.trimmed();
+        self.materials
+            .get(id)
+            .copied()
+            .ok_or_else(|| self.err(m, format!("{name}: unknown material id '{id}'")))
+    }
+}
+
+mod objects;
