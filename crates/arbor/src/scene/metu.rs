@@ -16,8 +16,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::tree::{Node, Unused};
-use super::{CameraDesc, Lens, LightDesc, MaterialDesc, MaterialKind, SceneDesc, Window};
-use crate::math::{Color, Mat4, Transform, Vec3};
+use super::{LightDesc, SceneDesc};
+use crate::math::{Mat4, Transform, Vec3};
 use crate::{Error, Location, Result};
 
 /// Reads the scene below the root element `root` of the file `path`.
@@ -93,14 +93,15 @@ impl Notes {
     fn plain(&mut self, loc: Location, msg: String) {
         self.lines.push((format!("{loc}: {msg}"), 1));
     }
-    fn feature(&mut self, loc: Location, name: &str, what: &str) {
-        if let Some(&i) = self.features.get(name) {
+    /// `label` names what was found (`<Texture>`, `attribute BRDF of <Material>`); `what` says what
+    /// Arbor does instead; one line per label.
+    fn feature(&mut self, loc: Location, label: &str, what: &str) {
+        if let Some(&i) = self.features.get(label) {
             self.lines[i].1 += 1;
             return;
         }
-        self.features.insert(name.to_string(), self.lines.len());
-        self.lines
-            .push((format!("{loc}: <{name}> ignored: {what} not supported"), 1));
+        self.features.insert(label.to_string(), self.lines.len());
+        self.lines.push((format!("{loc}: {label}: {what}"), 1));
     }
     fn finish(self) -> Vec<String> {
         let times = |(s, n): (String, usize)| match n {
@@ -163,11 +164,14 @@ impl Reader<'_> {
         parent.required(name, self.path)
     }
 
-    /// Reports every `name` child of `parent` as an unsupported feature and marks it read.
+    /// Reports every `name` child of `parent` as an unsupported feature (`what` is the feature, as the
+    /// subject of "not supported") and marks it read.
     fn unsupported(&mut self, parent: &Node, name: &str, what: &str) {
         for n in parent.all(name) {
             n.mark_subtree_used();
-            self.notes.feature(n.loc(self.path), name, what);
+            let msg = format!("{what} not supported; ignored");
+            self.notes
+                .feature(n.loc(self.path), &format!("<{name}>"), &msg);
         }
     }
 
@@ -261,117 +265,6 @@ impl Reader<'_> {
         Ok(acc)
     }
 
-    fn camera(&mut self, c: &Node, index: usize) -> Result<CameraDesc> {
-        let p = self.path;
-        let id = c
-            .attr("id")
-            .map_or_else(|| (index + 1).to_string(), |a| a.trimmed().to_string());
-        let look_at = match c.attr("type").map(|a| (a, a.trimmed())) {
-            None => false,
-            Some((_, "lookAt")) => true,
-            Some((a, other)) => {
-                let msg = format!("Camera {id}: unknown type '{other}' (expected lookAt)");
-                return Err(Error::input(a.loc(p), msg));
-            }
-        };
-        if let Some(h) = c.attr("handedness").filter(|h| h.trimmed() != "right") {
-            let msg = format!(
-                "Camera {id}: handedness '{}' not supported; right-handed used",
-                h.trimmed()
-            );
-            self.notes.plain(h.loc(p), msg);
-        }
-        let position = self.req(c, "Position")?.vec3(p)?;
-        let up = self.req(c, "Up")?.vec3(p)?;
-        let near_distance = self.req(c, "NearDistance")?.float(p)?;
-        let res_node = self.req(c, "ImageResolution")?;
-        let res = res_node.ints(p)?;
-        let (width, height) = match res[..] {
-            [w, h] if w > 0 && h > 0 && w <= u32::MAX as i64 && h <= u32::MAX as i64 => {
-                (w as u32, h as u32)
-            }
-            _ => {
-                return Err(self.err(
-                    res_node,
-                    "<ImageResolution>: expected two positive integers",
-                ))
-            }
-        };
-        let image_name = self.req(c, "ImageName")?.trimmed().to_string();
-        let num_samples = match self.one(c, "NumSamples") {
-            Some(n) => n.uint(p)?.max(1),
-            None => 1,
-        };
-        let (gaze, window) = if look_at {
-            let gaze = match self.one(c, "GazePoint") {
-                Some(g) => g.vec3(p)? - position,
-                None => self.req(c, "Gaze")?.vec3(p)?,
-            };
-            let fov_deg = self.req(c, "FovY")?.float(p)?;
-            let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
-            let right = top * width as f32 / height as f32;
-            (
-                gaze,
-                Window {
-                    left: -right,
-                    right,
-                    bottom: -top,
-                    top,
-                },
-            )
-        } else {
-            let gaze = self.req(c, "Gaze")?.vec3(p)?;
-            let np = self.req(c, "NearPlane")?;
-            let v = np.floats_n(4, true, p)?;
-            let extra = np.trimmed().split_whitespace().count();
-            if extra > 4 {
-                let msg = format!("<NearPlane> has {extra} numbers; only the first 4 are used");
-                self.notes.plain(np.loc(p), msg);
-            }
-            (
-                gaze,
-                Window {
-                    left: v[0],
-                    right: v[1],
-                    bottom: v[2],
-                    top: v[3],
-                },
-            )
-        };
-        if gaze.length_squared() == 0.0 {
-            return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
-        }
-        let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
-            (None, None) => None,
-            (Some(f), Some(a)) => Some(Lens {
-                aperture: a.float(p)?,
-                focus_distance: f.float(p)?,
-            }),
-            (Some(_), None) => return Err(self.err(c, "<Camera>: missing <ApertureSize>")),
-            (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
-        };
-        let transform = self.transform_of(c)?;
-        self.unsupported(c, "Tonemap", "tone mapping is");
-        self.unsupported(c, "Renderer", "path tracing is");
-        self.unsupported(c, "RendererParams", "path tracing is");
-        Ok(CameraDesc {
-            id,
-            position,
-            gaze,
-            up,
-            window,
-            near_distance,
-            orthographic: false,
-            width,
-            height,
-            image_name,
-            num_samples,
-            transform,
-            lens,
-            loc: c.loc(p),
-        })
-    }
-
     fn lights(&mut self, l: &Node) -> Result<()> {
         let p = self.path;
         if let Some(a) = self.one(l, "AmbientLight") {
@@ -421,105 +314,8 @@ impl Reader<'_> {
         v.try_normalize()
             .ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
     }
-
-    fn read_materials(&mut self, ms: &Node) -> Result<()> {
-        for (i, m) in ms.all("Material").enumerate() {
-            let id = m
-                .attr("id")
-                .map_or_else(|| (i + 1).to_string(), |a| a.trimmed().to_string());
-            let mat = self.material(m, id.clone())?;
-            if self
-                .materials
-                .insert(id.clone(), self.desc.materials.len())
-                .is_some()
-            {
-                return Err(self.err(m, format!("duplicate material id '{id}'")));
-            }
-            self.desc.materials.push(mat);
-        }
-        Ok(())
-    }
-
-    fn material(&mut self, m: &Node, id: String) -> Result<MaterialDesc> {
-        let p = self.path;
-        let color = |r: &mut Self, name: &str| -> Result<Option<Color>> {
-            r.one(m, name).map(|n| n.vec3(p)).transpose()
-        };
-        let ambient = self.req(m, "AmbientReflectance")?.vec3(p)?;
-        let diffuse = self.req(m, "DiffuseReflectance")?.vec3(p)?;
-        let specular = color(self, "SpecularReflectance")?.unwrap_or(Color::ZERO);
-        let phong_exponent = match self.one(m, "PhongExponent") {
-            Some(n) => n.float(p)?,
-            None => 1.0,
-        };
-        let float = |r: &mut Self, name: &str| -> Result<f32> { r.req(m, name)?.float(p) };
-        let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
-            Some((_, t)) if t == "mirror" => MaterialKind::Mirror {
-                reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
-            },
-            Some((_, t)) if t == "conductor" => MaterialKind::Conductor {
-                reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
-                eta: float(self, "RefractionIndex")?,
-                k: float(self, "AbsorptionIndex")?,
-            },
-            Some((_, t)) if t == "dielectric" => MaterialKind::Dielectric {
-                eta: float(self, "RefractionIndex")?,
-                absorption: color(self, "AbsorptionCoefficient")?.unwrap_or(Color::ZERO),
-            },
-            Some((a, t)) => {
-                let msg = format!(
-                    "Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)"
-                );
-                return Err(Error::input(a.loc(p), msg));
-            }
-            None => {
-                // Pre-2020 files have no type; the elements present say what the material is.
-                let mirror = color(self, "MirrorReflectance")?.unwrap_or(Color::ZERO);
-                let transparency = color(self, "Transparency")?.unwrap_or(Color::ZERO);
-                if transparency != Color::ZERO {
-                    let eta = float(self, "RefractionIndex")?;
-                    MaterialKind::Transparent {
-                        eta,
-                        transparency,
-                        mirror,
-                    }
-                } else if mirror != Color::ZERO {
-                    MaterialKind::Mirror {
-                        reflectance: mirror,
-                    }
-                } else {
-                    MaterialKind::BlinnPhong
-                }
-            }
-        };
-        if let Some(a) = m.attr("BRDF") {
-            self.notes
-                .feature(a.loc(p), "Material BRDF=", "BRDF models are");
-        }
-        if let Some(a) = m.attr("degamma") {
-            self.notes
-                .feature(a.loc(p), "Material degamma=", "degamma is");
-        }
-        self.unsupported(m, "Roughness", "glossy reflection is");
-        Ok(MaterialDesc {
-            id,
-            ambient,
-            diffuse,
-            specular,
-            phong_exponent,
-            kind,
-        })
-    }
-
-    /// The material an object names, as an index.
-    fn material_of(&mut self, o: &Node, name: &str) -> Result<usize> {
-        let m = self.req(o, "Material")?;
-        let id = m.trimmed();
-        self.materials
-            .get(id)
-            .copied()
-            .ok_or_else(|| self.err(m, format!("{name}: unknown material id '{id}'")))
-    }
 }
 
+mod camera;
+mod material;
 mod objects;

@@ -47,8 +47,9 @@ impl Reader<'_> {
             let id = o.attr("id").map(|a| a.trimmed().to_string());
             let name = format!("{kind} {}", id.as_deref().unwrap_or("(no id)"));
             if kind.starts_with("Light") {
-                let what = "emission is (rendered as an ordinary object)";
-                self.notes.feature(o.loc(self.path), kind, what);
+                let what = "emission not supported; rendered as an ordinary object";
+                self.notes
+                    .feature(o.loc(self.path), &format!("<{kind}>"), what);
                 o.child("Radiance").map(Node::mark_subtree_used);
             }
             self.unsupported(o, "MotionBlur", "motion blur is");
@@ -187,8 +188,9 @@ impl Reader<'_> {
             return Err(Error::input(t.loc(p), msg));
         }
         if let Some(a) = faces.attr("textureOffset") {
+            let label = "attribute textureOffset of <Faces>";
             self.notes
-                .feature(a.loc(p), "Faces textureOffset=", "textures are");
+                .feature(a.loc(p), label, "textures not supported; ignored");
         }
         if let Some(ply) = faces.attr("plyFile") {
             if !faces.trimmed().is_empty() {
