@@ -319,3 +319,71 @@ impl Reader<'_> {
 mod camera;
 mod material;
 mod objects;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{xml, ShapeDesc};
+
+    fn read_xml(body: &str) -> Result<SceneDesc> {
+        let path = Path::new("t.xml");
+        read(&xml::parse(&format!("<Scene>{body}</Scene>"), path)?, path)
+    }
+
+    const MATERIAL: &str =
+        "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+        <DiffuseReflectance>1 1 1</DiffuseReflectance></Material></Materials>";
+
+    #[test]
+    fn metu_instance_may_precede_its_base_and_reset_drops_base_transform() {
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0 1 0 0 0 1 0</VertexData>\
+             <Transformations><Translation id=\"1\">0 0 5</Translation>\
+             <Scaling id=\"1\">3 3 3</Scaling></Transformations><Objects>\
+             <MeshInstance id=\"1\" baseMeshId=\"2\" resetTransform=\"true\">\
+             <Transformations>s1</Transformations></MeshInstance>\
+             <MeshInstance id=\"2\" baseMeshId=\"2\"><Transformations>s1</Transformations></MeshInstance>\
+             <Mesh id=\"2\"><Material>1</Material><Transformations>t1</Transformations>\
+             <Faces>1 2 3</Faces></Mesh></Objects>"
+        );
+        let d = read_xml(&body).unwrap();
+        assert_eq!(d.objects[0].shape, ShapeDesc::Instance { base: 2 });
+        assert_eq!(d.objects[0].material, 0, "inherits the base's material");
+        let o = Vec3::ONE;
+        assert_eq!(d.objects[0].transform.point(o), Vec3::splat(3.0));
+        // Without reset: the base's translation first, then the instance's scale.
+        assert_eq!(d.objects[1].transform.point(o), Vec3::new(3.0, 3.0, 18.0));
+    }
+
+    #[test]
+    fn metu_unsupported_feature_is_one_warning_with_a_count() {
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0</VertexData><Objects>\
+             <Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <MotionBlur>0 0 1</MotionBlur></Sphere>\
+             <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <MotionBlur>0 0 1</MotionBlur></Sphere></Objects>"
+        );
+        let d = read_xml(&body).unwrap();
+        assert_eq!(
+            d.warnings,
+            ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]
+        );
+    }
+
+    #[test]
+    fn metu_root_must_be_scene_and_types_must_be_known() {
+        let path = Path::new("t.xml");
+        let e = read(&xml::parse("<Scen/>", path).unwrap(), path).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:1: root element is <Scen>, expected <Scene>"
+        );
+        let body = MATERIAL.replace("id=\"1\"", "id=\"1\" type=\"glass\"");
+        let e = read_xml(&body).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:36: Material 1: unknown type 'glass' (expected mirror, conductor or dielectric)"
+        );
+    }
+}

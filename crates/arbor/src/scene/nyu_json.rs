@@ -355,3 +355,57 @@ fn num(v: &Spanned) -> Option<f32> {
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nyu_looks_like_nyu_tells_the_forms_apart() {
+        assert!(looks_like_nyu(
+            "{\"Scene\": {\"Background\": [0, 0, 0]}, \"Camera\": {}}"
+        ));
+        assert!(looks_like_nyu("{\"Objects\": []}"));
+        let metu = "{\"Scene\": {\"Cameras\": {\"Camera\": {}}, \"Objects\": {}}}";
+        assert!(!looks_like_nyu(metu));
+        assert!(!looks_like_nyu("{\"Scene\": {"));
+        assert!(!looks_like_nyu("not json"));
+    }
+
+    #[test]
+    fn nyu_camera_looks_down_z_with_vertical_fov() {
+        let text = "{\"Camera\": {\"IsPerspective\": true, \"Position\": [0, 0, 2], \
+                    \"FieldOfView\": 1.5707964, \"FocalLength\": 2.0, \"LensRadius\": 0.1}}";
+        let d = parse(text, Path::new("data/scene.json")).unwrap();
+        let c = &d.cameras[0];
+        assert_eq!(
+            (c.gaze, c.up, c.orthographic),
+            (Vec3::NEG_Z, Vec3::Y, false)
+        );
+        // 90° vertical at focal length 2: top = 2; 640x480 makes right 8/3.
+        assert!((c.window.top - 2.0).abs() < 1e-5 && (c.window.right - 8.0 / 3.0).abs() < 1e-5);
+        assert_eq!(
+            (c.image_name.as_str(), c.near_distance, c.lens),
+            ("scene.png", 2.0, None)
+        );
+        assert_eq!(
+            d.warnings.len(),
+            1,
+            "the lens is reported: {:?}",
+            d.warnings
+        );
+    }
+
+    #[test]
+    fn nyu_errors_name_the_key_and_its_line() {
+        let text =
+            "{\n  \"Camera\": {\"Position\": [0, 0], \"FieldOfView\": 1, \"FocalLength\": 1}\n}";
+        let e = parse(text, Path::new("s.json")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "s.json:2:14: \"Position\": expected an array of 3 numbers"
+        );
+        let e = parse("{\"Objects\": []}", Path::new("s.json")).unwrap_err();
+        assert_eq!(e.to_string(), "s.json:1:1: the scene: missing \"Camera\"");
+    }
+}

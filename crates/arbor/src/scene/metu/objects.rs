@@ -11,17 +11,16 @@ use std::sync::Arc;
 
 use super::Reader;
 use crate::geometry::TriangleMesh;
-use crate::math::{Transform, Vec3};
+use crate::math::Vec3;
 use crate::scene::tree::{Attr, Node};
 use crate::scene::{MeshSource, ObjectDesc, ShapeDesc};
 use crate::{Error, Result};
 
-/// A `MeshInstance` waiting for its base mesh.
+/// A `MeshInstance` waiting for its base mesh; its own transform is already in its object.
 struct Pending<'n> {
     object: usize,
     base_id: &'n Attr,
     reset: bool,
-    own: Transform,
     has_material: bool,
 }
 
@@ -72,7 +71,6 @@ impl Reader<'_> {
                     object: self.desc.objects.len(),
                     base_id,
                     reset,
-                    own: Transform::IDENTITY,
                     has_material,
                 });
                 (material, ShapeDesc::Instance { base: 0 })
@@ -81,12 +79,6 @@ impl Reader<'_> {
                 (material, self.shape(o, &name)?)
             };
             let transform = self.transform_of(o)?;
-            if let Some(p) = pending
-                .last_mut()
-                .filter(|p| p.object == self.desc.objects.len())
-            {
-                p.own = transform;
-            }
             if kind == "Mesh" {
                 if let Some(id) = &id {
                     mesh_ids.insert(id.clone(), self.desc.objects.len());
@@ -116,11 +108,9 @@ impl Reader<'_> {
             let inst = &mut self.desc.objects[p.object];
             inst.shape = ShapeDesc::Instance { base };
             // Without resetTransform the instance moves the base mesh from where the base put it.
-            inst.transform = if p.reset {
-                p.own
-            } else {
-                base_transform.then(&p.own)
-            };
+            if !p.reset {
+                inst.transform = base_transform.then(&inst.transform);
+            }
             if !p.has_material {
                 inst.material = base_material;
             }
