@@ -182,6 +182,9 @@ struct Scanner<'a> {
     pos: usize,
     line: u32,
     col: u32,
+    /// Open arrays and objects: the scan is recursive and [`top_level_keys`] runs it on unchecked
+    /// text, so nesting is bounded (as serde_json bounds it, at 128).
+    depth: u32,
 }
 
 type Scan<T> = std::result::Result<T, ()>;
@@ -193,6 +196,7 @@ impl<'a> Scanner<'a> {
             pos: 0,
             line: 1,
             col: 1,
+            depth: 0,
         }
     }
     fn peek(&self) -> Option<u8> {
@@ -227,8 +231,9 @@ impl<'a> Scanner<'a> {
         self.ws();
         let (line, col) = (self.line, self.col);
         let value = match self.peek().ok_or(())? {
-            b'{' => Value::Object(self.object()?),
-            b'[' => Value::Array(self.array()?),
+            b'{' | b'[' if self.depth >= 128 => return Err(()),
+            b'{' => self.nested(Self::object, Value::Object)?,
+            b'[' => self.nested(Self::array, Value::Array)?,
             b'"' => Value::Str(self.string()?),
             b't' => self.word("true", Value::Bool(true))?,
             b'f' => self.word("false", Value::Bool(false))?,
@@ -236,6 +241,12 @@ impl<'a> Scanner<'a> {
             _ => Value::Number(self.number()?),
         };
         Ok(Spanned { value, line, col })
+    }
+    fn nested<T>(&mut self, f: fn(&mut Self) -> Scan<T>, wrap: fn(T) -> Value) -> Scan<Value> {
+        self.depth += 1;
+        let v = f(self)?;
+        self.depth -= 1;
+        Ok(wrap(v))
     }
     fn word(&mut self, w: &str, v: Value) -> Scan<Value> {
         for &b in w.as_bytes() {
@@ -376,6 +387,8 @@ mod tests {
             top_level_keys(" {\"Camera\": {\"a\": [1, {\"b\": \"}\"}]}, \"Objects\": []}").unwrap();
         assert_eq!(keys, ["Camera", "Objects"]);
         assert_eq!(top_level_keys("[1]"), None);
+        let deep = format!("{{\"a\": {}", "[".repeat(100_000));
+        assert_eq!(top_level_keys(&deep), None);
     }
 
     #[test]

@@ -28,11 +28,24 @@ pub fn parse(text: &str, path: &Path) -> Result<Node> {
         )
     })?;
     let lines = LineIndex::new(text);
-    Ok(convert(doc.root_element(), &lines))
+    convert(doc.root_element(), &lines, 0, path)
 }
 
-fn convert(e: roxmltree::Node<'_, '_>, lines: &LineIndex<'_>) -> Node {
+/// Deeper than any scene needs; the tree is walked recursively, so a hostile file must not nest
+/// without bound (serde_json applies a similar limit, 128, to JSON).
+const MAX_DEPTH: usize = 128;
+
+fn convert(
+    e: roxmltree::Node<'_, '_>,
+    lines: &LineIndex<'_>,
+    depth: usize,
+    path: &Path,
+) -> Result<Node> {
     let (line, col) = lines.pos(e.range().start);
+    if depth > MAX_DEPTH {
+        let msg = format!("elements nested more than {MAX_DEPTH} deep");
+        return Err(Error::input(Location::at(path, line, col), msg));
+    }
     let mut node = Node::new(e.tag_name().name(), line, col);
     for a in e.attributes() {
         let (line, col) = lines.pos(a.range().start);
@@ -40,14 +53,14 @@ fn convert(e: roxmltree::Node<'_, '_>, lines: &LineIndex<'_>) -> Node {
     }
     for c in e.children() {
         if c.is_element() {
-            node.children.push(convert(c, lines));
+            node.children.push(convert(c, lines, depth + 1, path)?);
         } else if c.is_text() {
             node.text.push_str(c.text().unwrap_or(""));
             // Text split by a child element or a comment must not fuse two numbers.
             node.text.push(' ');
         }
     }
-    node
+    Ok(node)
 }
 
 /// Byte offset to 1-based line and column (in characters).
@@ -94,6 +107,16 @@ mod tests {
         let s = e.to_string();
         assert!(s.starts_with("bad.xml:2:"), "{s}");
         assert!(s.contains("XML syntax error"), "{s}");
+    }
+
+    #[test]
+    fn xml_deep_nesting_is_an_error_not_a_stack_overflow() {
+        let text = format!("{}{}", "<a>".repeat(1000), "</a>".repeat(1000));
+        let e = parse(&text, Path::new("deep.xml")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "deep.xml:1:388: elements nested more than 128 deep"
+        );
     }
 
     #[test]
