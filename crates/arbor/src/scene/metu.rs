@@ -82,7 +82,8 @@ pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
     Ok(r.desc)
 }
 
-/// Warnings in file-reading order; an unsupported feature is one line however often it occurs.
+/// Warnings: what reading met, in reading order, then what it never read, in file order. An unsupported
+/// feature is one line however often it occurs.
 #[derive(Default)]
 struct Notes {
     lines: Vec<(String, usize)>,
@@ -112,6 +113,7 @@ impl Notes {
     }
 }
 
+/// The scene being read, and what the file has defined so far for later elements to refer to.
 struct Reader<'a> {
     path: &'a Path,
     dir: PathBuf,
@@ -216,28 +218,23 @@ impl Reader<'_> {
             let id = n
                 .attr("id")
                 .ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
-            let made = match prefix {
-                "t" => Some(Transform::translate(n.vec3(p)?)),
-                "s" => Transform::scale(n.vec3(p)?),
+            let (made, degenerate) = match prefix {
+                "t" => (Some(Transform::translate(n.vec3(p)?)), ""),
+                "s" => (Transform::scale(n.vec3(p)?), "a scale factor is zero"),
                 "r" => {
                     let v = n.floats_n(4, false, p)?;
-                    Transform::rotate(v[0], Vec3::new(v[1], v[2], v[3]))
+                    let axis = Vec3::new(v[1], v[2], v[3]);
+                    (Transform::rotate(v[0], axis), "the rotation axis is zero")
                 }
                 _ => {
                     let v = n.floats_n(16, false, p)?;
                     let rows: [f32; 16] = v.try_into().unwrap_or([0.0; 16]);
-                    Transform::from_mat4(Mat4::from_cols_array(&rows).transpose())
+                    // The file gives rows; glam takes columns.
+                    let m = Mat4::from_cols_array(&rows).transpose();
+                    (Transform::from_mat4(m), "the matrix is not invertible")
                 }
             };
-            let made = made.ok_or_else(|| {
-                self.err(
-                    n,
-                    format!(
-                        "<{}>: degenerate transformation (zero scale or axis)",
-                        n.name
-                    ),
-                )
-            })?;
+            let made = made.ok_or_else(|| self.err(n, format!("<{}>: {degenerate}", n.name)))?;
             let key = format!("{prefix}{}", id.trimmed());
             if self.transforms.insert(key.clone(), made).is_some() {
                 return Err(self.err(n, format!("duplicate transformation '{key}'")));
@@ -368,6 +365,22 @@ mod tests {
         assert_eq!(
             d.warnings,
             ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]
+        );
+    }
+
+    #[test]
+    fn metu_degenerate_transformations_are_errors() {
+        let e = read_xml("<Transformations><Scaling id=\"2\">1 0 1</Scaling></Transformations>")
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Scaling>: a scale factor is zero"
+        );
+        let c = "<Transformations><Composite id=\"1\">0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1</Composite></Transformations>";
+        let e = read_xml(c).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Composite>: the matrix is not invertible"
         );
     }
 
