@@ -8,6 +8,7 @@ use crate::scene::{CameraDesc, Lens, Window};
 use crate::{Error, Result};
 
 impl Reader<'_> {
+    /// One `Camera`; `index` (from 0) names it when it has no id.
     pub(super) fn camera(&mut self, c: &Node, index: usize) -> Result<CameraDesc> {
         let p = self.path;
         let id = c
@@ -44,7 +45,11 @@ impl Reader<'_> {
                 ))
             }
         };
-        let image_name = self.req(c, "ImageName")?.trimmed().to_string();
+        let name_node = self.req(c, "ImageName")?;
+        let image_name = name_node.trimmed().to_string();
+        if image_name.is_empty() {
+            return Err(self.err(name_node, "<ImageName>: empty file name"));
+        }
         let num_samples = match self.one(c, "NumSamples") {
             Some(n) => n.uint(p)?.max(1),
             None => 1,

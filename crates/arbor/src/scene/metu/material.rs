@@ -9,6 +9,7 @@ use crate::scene::{MaterialDesc, MaterialKind};
 use crate::{Error, Result};
 
 impl Reader<'_> {
+    /// Every `Material`, numbered in file order; their ids map to those indices.
     pub(super) fn read_materials(&mut self, ms: &Node) -> Result<()> {
         for (i, m) in ms.all("Material").enumerate() {
             let id = m
@@ -27,6 +28,7 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// One `Material` whose id is `id`.
     fn material(&mut self, m: &Node, id: String) -> Result<MaterialDesc> {
         let p = self.path;
         let color = |r: &mut Self, name: &str| -> Result<Option<Color>> {

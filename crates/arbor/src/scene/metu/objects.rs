@@ -25,6 +25,7 @@ struct Pending<'n> {
 }
 
 impl Reader<'_> {
+    /// Every object of `Objects`, in file order, then the instances' bases.
     pub(super) fn objects(&mut self, objects: &Node) -> Result<()> {
         let mut mesh_ids: HashMap<String, usize> = HashMap::new();
         let mut pending = Vec::new();
@@ -118,6 +119,7 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// The geometry of `o`, any kind but `MeshInstance`.
     fn shape(&mut self, o: &Node, name: &str) -> Result<ShapeDesc> {
         let p = self.path;
         Ok(match o.name.as_str() {
@@ -168,6 +170,7 @@ impl Reader<'_> {
         })
     }
 
+    /// A mesh's `Faces`: a PLY file, or inline vertex ids.
     fn faces(&mut self, faces: &Node, name: &str) -> Result<MeshSource> {
         let p = self.path;
         if let Some(t) = faces.attr("type").filter(|t| t.trimmed() != "triangle") {
