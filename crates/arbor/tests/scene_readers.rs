@@ -461,7 +461,14 @@ fn readers_facts_of_shared_scenes() {
     let d = load_desc(&hw1.join("other_dragon.xml")).unwrap();
     let c = &d.cameras[0];
     assert_eq!((c.width, c.height), (800, 480));
-    assert!((c.window.right / c.window.top - 800.0 / 480.0).abs() < 1e-5);
+    // FovY 32 at NearDistance 1: top = tan(16°) = 0.286745; right = top * 800/480 = 0.477909.
+    assert!((c.window.top - 0.286745).abs() < 1e-5, "{:?}", c.window);
+    assert!((c.window.right - 0.477909).abs() < 1e-5, "{:?}", c.window);
+    assert_eq!(
+        (c.window.left, c.window.bottom),
+        (-c.window.right, -c.window.top)
+    );
+    assert!(close(c.gaze, Vec3::new(-500.0, 200.0, -160.0)));
     assert!(
         matches!(&d.objects[0].shape, ShapeDesc::Mesh { source: MeshSource::File(p), .. } if p.ends_with("ply/dragon_remeshed_fixed.ply"))
     );
