@@ -1,5 +1,402 @@
-//! (being written)
-use super::{tree::Node, SceneDesc};
-pub fn read(_root: &Node, path: &std::path::Path) -> crate::Result<SceneDesc> {
-    Err(crate::Error::Invalid(format!("{}: METU reader not written yet", path.display())))
+//! The METU CENG 795 scene schema (XML, and the 2025 JSON form of it), read from the element tree into
+//! a [`SceneDesc`]. The schema, its defaults and its quirks are described in `shared/scenes/README.md`
+//! section (ii); the rules that matter here:
+//!
+//! - ids are 1-based and per kind; materials become indices, inline meshes are compacted to the
+//!   vertices they use (0-based), a sphere's `Center` and a plane's `Point` are vertex ids;
+//! - `Transformations` lists named transforms (`t1 s2 r1 c1`) applied left to right;
+//! - a look-at camera's window is `top = NearDistance·tan(FovY/2)`, `right = top·width/height`;
+//! - untyped (pre-2020) materials: a non-zero `Transparency` means glass, else a non-zero
+//!   `MirrorReflectance` means a mirror;
+//! - duplicated single-valued elements: the last one wins, with a warning;
+//! - what Arbor does not render (textures, motion blur, BRDFs, tone mapping...) is one warning per
+//!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use super::tree::{Node, Unused};
+use super::{LightDesc, SceneDesc};
+use crate::math::{Mat4, Transform, Vec3};
+use crate::{Error, Location, Result};
+
+/// Reads the scene below the root element `root` of the file `path`.
+pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
+    if root.name != "Scene" {
+        return Err(Error::input(
+            root.loc(path),
+            format!("root element is <{}>, expected <Scene>", root.name),
+        ));
+    }
+    root.mark_used();
+    let mut r = Reader {
+        path,
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        desc: SceneDesc::new(path),
+        notes: Notes::default(),
+        vertices: Vec::new(),
+        transforms: HashMap::new(),
+        materials: HashMap::new(),
+    };
+    r.globals(root)?;
+    if let Some(v) = r.one(root, "VertexData") {
+        r.vertices = vertex_data(v, path)?;
+    }
+    if let Some(t) = r.one(root, "Transformations") {
+        r.transformations(t)?;
+    }
+    if let Some(m) = r.one(root, "Materials") {
+        r.read_materials(m)?;
+    }
+    if let Some(c) = r.one(root, "Cameras") {
+        for (i, cam) in c.all("Camera").enumerate() {
+            let cam = r.camera(cam, i)?;
+            r.desc.cameras.push(cam);
+        }
+    }
+    if let Some(l) = r.one(root, "Lights") {
+        r.lights(l)?;
+    }
+    if let Some(o) = r.one(root, "Objects") {
+        r.objects(o)?;
+    }
+    for u in root.unused() {
+        match u {
+            Unused::Element(n, parent) => r.notes.plain(
+                n.loc(path),
+                format!(
+                    "<{}> in <{parent}> ignored (unknown or unused here)",
+                    n.name
+                ),
+            ),
+            Unused::Attr(a, elem) => r.notes.plain(
+                a.loc(path),
+                format!(
+                    "attribute {} of <{elem}> ignored (unknown or unused here)",
+                    a.name
+                ),
+            ),
+        }
+    }
+    r.desc.warnings = r.notes.finish();
+    Ok(r.desc)
+}
+
+/// Warnings: what reading met, in reading order, then what it never read, in file order. An unsupported
+/// feature is one line however often it occurs.
+#[derive(Default)]
+struct Notes {
+    lines: Vec<(String, usize)>,
+    features: HashMap<String, usize>,
+}
+
+impl Notes {
+    fn plain(&mut self, loc: Location, msg: String) {
+        self.lines.push((format!("{loc}: {msg}"), 1));
+    }
+    /// `label` names what was found (`<Texture>`, `attribute BRDF of <Material>`); `what` says what
+    /// Arbor does instead; one line per label.
+    fn feature(&mut self, loc: Location, label: &str, what: &str) {
+        if let Some(&i) = self.features.get(label) {
+            self.lines[i].1 += 1;
+            return;
+        }
+        self.features.insert(label.to_string(), self.lines.len());
+        self.lines.push((format!("{loc}: {label}: {what}"), 1));
+    }
+    fn finish(self) -> Vec<String> {
+        let times = |(s, n): (String, usize)| match n {
+            1 => s,
+            n => format!("{s} ({n} occurrences)"),
+        };
+        self.lines.into_iter().map(times).collect()
+    }
+}
+
+/// The scene being read, and what the file has defined so far for later elements to refer to.
+struct Reader<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+    desc: SceneDesc,
+    notes: Notes,
+    vertices: Vec<Vec3>,
+    transforms: HashMap<String, Transform>,
+    materials: HashMap<String, usize>,
+}
+
+fn vertex_data(v: &Node, path: &Path) -> Result<Vec<Vec3>> {
+    if let Some(t) = v.attr("type") {
+        if t.trimmed() != "xyz" {
+            let msg = format!(
+                "<VertexData>: unknown type '{}' (expected xyz)",
+                t.trimmed()
+            );
+            return Err(Error::input(t.loc(path), msg));
+        }
+    }
+    let f = v.floats(path)?;
+    if f.len() % 3 != 0 {
+        let msg = format!(
+            "<VertexData>: expected x y z triples, found {} numbers",
+            f.len()
+        );
+        return Err(Error::input(v.loc(path), msg));
+    }
+    Ok(f.chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+impl Reader<'_> {
+    fn err(&self, n: &Node, msg: impl Into<String>) -> Error {
+        Error::input(n.loc(self.path), msg)
+    }
+
+    /// The child `name` of `parent`, warning about duplicates (the last one wins).
+    fn one<'n>(&mut self, parent: &'n Node, name: &str) -> Option<&'n Node> {
+        for d in parent.duplicates(name) {
+            let msg = format!("duplicate <{name}> in <{}>; the last one wins", parent.name);
+            self.notes.plain(d.loc(self.path), msg);
+        }
+        parent.child(name)
+    }
+
+    fn req<'n>(&mut self, parent: &'n Node, name: &str) -> Result<&'n Node> {
+        self.one(parent, name);
+        parent.required(name, self.path)
+    }
+
+    /// Reports every `name` child of `parent` as an unsupported feature (`what` is the feature, as the
+    /// subject of "not supported") and marks it read.
+    fn unsupported(&mut self, parent: &Node, name: &str, what: &str) {
+        for n in parent.all(name) {
+            n.mark_subtree_used();
+            let msg = format!("{what} not supported; ignored");
+            self.notes
+                .feature(n.loc(self.path), &format!("<{name}>"), &msg);
+        }
+    }
+
+    fn globals(&mut self, root: &Node) -> Result<()> {
+        let p = self.path;
+        if let Some(n) = self.one(root, "BackgroundColor") {
+            self.desc.background = n.vec3(p)?;
+        }
+        if let Some(n) = self.one(root, "ShadowRayEpsilon") {
+            self.desc.shadow_epsilon = n.float(p)?;
+        }
+        if let Some(n) = self.one(root, "IntersectionTestEpsilon") {
+            self.desc.intersection_epsilon = n.float(p)?;
+        }
+        if let Some(n) = self.one(root, "MaxRecursionDepth") {
+            self.desc.max_depth = n.uint(p)?;
+        }
+        if let Some(n) = self.one(root, "BackfaceCulling") {
+            self.desc.cull_backfaces = Some(n.boolean(p)?);
+        }
+        if let Some(n) = self.one(root, "TexCoordData") {
+            // Read for its syntax only: nothing Arbor renders uses texture coordinates.
+            n.floats(p)?;
+        }
+        self.unsupported(root, "Textures", "textures are");
+        self.unsupported(root, "BackgroundTexture", "background textures are");
+        self.unsupported(root, "BRDFs", "BRDF models are");
+        Ok(())
+    }
+
+    fn transformations(&mut self, t: &Node) -> Result<()> {
+        let p = self.path;
+        for n in &t.children {
+            let prefix = match n.name.as_str() {
+                "Translation" => "t",
+                "Scaling" => "s",
+                "Rotation" => "r",
+                "Composite" => "c",
+                _ => continue,
+            };
+            n.mark_used();
+            let id = n
+                .attr("id")
+                .ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
+            let (made, degenerate) = match prefix {
+                "t" => (Some(Transform::translate(n.vec3(p)?)), ""),
+                "s" => (Transform::scale(n.vec3(p)?), "a scale factor is zero"),
+                "r" => {
+                    let v = n.floats_n(4, false, p)?;
+                    let axis = Vec3::new(v[1], v[2], v[3]);
+                    (Transform::rotate(v[0], axis), "the rotation axis is zero")
+                }
+                _ => {
+                    let v = n.floats_n(16, false, p)?;
+                    let rows: [f32; 16] = v.try_into().unwrap_or([0.0; 16]);
+                    // The file gives rows; glam takes columns.
+                    let m = Mat4::from_cols_array(&rows).transpose();
+                    (Transform::from_mat4(m), "the matrix is not invertible")
+                }
+            };
+            let made = made.ok_or_else(|| self.err(n, format!("<{}>: {degenerate}", n.name)))?;
+            let key = format!("{prefix}{}", id.trimmed());
+            if self.transforms.insert(key.clone(), made).is_some() {
+                return Err(self.err(n, format!("duplicate transformation '{key}'")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The `Transformations` child of `n`, composed left to right; identity when absent.
+    fn transform_of(&mut self, n: &Node) -> Result<Transform> {
+        let Some(list) = self.one(n, "Transformations") else {
+            return Ok(Transform::IDENTITY);
+        };
+        let mut acc = Transform::IDENTITY;
+        for name in list.trimmed().split_whitespace() {
+            let t = self.transforms.get(name).ok_or_else(|| {
+                self.err(
+                    list,
+                    format!("<Transformations>: unknown transformation '{name}'"),
+                )
+            })?;
+            // The first listed is applied first (README (ii), "Mesh/Transformations").
+            acc = acc.then(t);
+        }
+        Ok(acc)
+    }
+
+    fn lights(&mut self, l: &Node) -> Result<()> {
+        let p = self.path;
+        if let Some(a) = self.one(l, "AmbientLight") {
+            self.desc.ambient = a.vec3(p)?;
+        }
+        for n in &l.children {
+            let light = match n.name.as_str() {
+                "PointLight" => LightDesc::Point {
+                    position: self.req(n, "Position")?.vec3(p)?,
+                    intensity: self.req(n, "Intensity")?.vec3(p)?,
+                },
+                "AreaLight" => LightDesc::Area {
+                    position: self.req(n, "Position")?.vec3(p)?,
+                    normal: self.unit(n, "Normal")?,
+                    size: self.req(n, "Size")?.float(p)?,
+                    radiance: self.req(n, "Radiance")?.vec3(p)?,
+                },
+                "DirectionalLight" => LightDesc::Directional {
+                    direction: self.unit(n, "Direction")?,
+                    radiance: self.req(n, "Radiance")?.vec3(p)?,
+                },
+                "SphericalDirectionalLight" => {
+                    let name = self.req(n, "EnvMapName")?.trimmed();
+                    if self.desc.environment.is_some() {
+                        let msg = "duplicate environment light; the last one wins".to_string();
+                        self.notes.plain(n.loc(p), msg);
+                    }
+                    self.desc.environment = Some(self.dir.join(name));
+                    n.mark_used();
+                    n.attr("id");
+                    continue;
+                }
+                _ => continue,
+            };
+            n.mark_used();
+            n.attr("id");
+            self.desc.lights.push(light);
+        }
+        self.unsupported(l, "SpotLight", "spot lights are");
+        Ok(())
+    }
+
+    /// The child `name` of `n` as a unit vector.
+    fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
+        let c = self.req(n, name)?;
+        let v = c.vec3(self.path)?;
+        v.try_normalize()
+            .ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
+    }
+}
+
+mod camera;
+mod material;
+mod objects;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{xml, ShapeDesc};
+
+    fn read_xml(body: &str) -> Result<SceneDesc> {
+        let path = Path::new("t.xml");
+        read(&xml::parse(&format!("<Scene>{body}</Scene>"), path)?, path)
+    }
+
+    const MATERIAL: &str =
+        "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+        <DiffuseReflectance>1 1 1</DiffuseReflectance></Material></Materials>";
+
+    #[test]
+    fn metu_instance_may_precede_its_base_and_reset_drops_base_transform() {
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0 1 0 0 0 1 0</VertexData>\
+             <Transformations><Translation id=\"1\">0 0 5</Translation>\
+             <Scaling id=\"1\">3 3 3</Scaling></Transformations><Objects>\
+             <MeshInstance id=\"1\" baseMeshId=\"2\" resetTransform=\"true\">\
+             <Transformations>s1</Transformations></MeshInstance>\
+             <MeshInstance id=\"2\" baseMeshId=\"2\"><Transformations>s1</Transformations></MeshInstance>\
+             <Mesh id=\"2\"><Material>1</Material><Transformations>t1</Transformations>\
+             <Faces>1 2 3</Faces></Mesh></Objects>"
+        );
+        let d = read_xml(&body).unwrap();
+        assert_eq!(d.objects[0].shape, ShapeDesc::Instance { base: 2 });
+        assert_eq!(d.objects[0].material, 0, "inherits the base's material");
+        let o = Vec3::ONE;
+        assert_eq!(d.objects[0].transform.point(o), Vec3::splat(3.0));
+        // Without reset: the base's translation first, then the instance's scale.
+        assert_eq!(d.objects[1].transform.point(o), Vec3::new(3.0, 3.0, 18.0));
+    }
+
+    #[test]
+    fn metu_unsupported_feature_is_one_warning_with_a_count() {
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0</VertexData><Objects>\
+             <Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <MotionBlur>0 0 1</MotionBlur></Sphere>\
+             <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <MotionBlur>0 0 1</MotionBlur></Sphere></Objects>"
+        );
+        let d = read_xml(&body).unwrap();
+        assert_eq!(
+            d.warnings,
+            ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]
+        );
+    }
+
+    #[test]
+    fn metu_degenerate_transformations_are_errors() {
+        let e = read_xml("<Transformations><Scaling id=\"2\">1 0 1</Scaling></Transformations>")
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Scaling>: a scale factor is zero"
+        );
+        let c = "<Transformations><Composite id=\"1\">0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1</Composite></Transformations>";
+        let e = read_xml(c).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Composite>: the matrix is not invertible"
+        );
+    }
+
+    #[test]
+    fn metu_root_must_be_scene_and_types_must_be_known() {
+        let path = Path::new("t.xml");
+        let e = read(&xml::parse("<Scen/>", path).unwrap(), path).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:1: root element is <Scen>, expected <Scene>"
+        );
+        let body = MATERIAL.replace("id=\"1\"", "id=\"1\" type=\"glass\"");
+        let e = read_xml(&body).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:36: Material 1: unknown type 'glass' (expected mirror, conductor or dielectric)"
+        );
+    }
 }

@@ -1,0 +1,126 @@
+//! METU cameras: the image-plane window from `NearPlane`, or for `type="lookAt"` from `FovY` and the
+//! image's aspect ratio (`top = NearDistance·tan(FovY/2)`, `right = top·width/height`), the camera's
+//! transformations and its thin lens.
+
+use super::Reader;
+use crate::scene::tree::Node;
+use crate::scene::{CameraDesc, Lens, Window};
+use crate::{Error, Result};
+
+impl Reader<'_> {
+    /// One `Camera`; `index` (from 0) names it when it has no id.
+    pub(super) fn camera(&mut self, c: &Node, index: usize) -> Result<CameraDesc> {
+        let p = self.path;
+        let id = c
+            .attr("id")
+            .map_or_else(|| (index + 1).to_string(), |a| a.trimmed().to_string());
+        let look_at = match c.attr("type").map(|a| (a, a.trimmed())) {
+            None => false,
+            Some((_, "lookAt")) => true,
+            Some((a, other)) => {
+                let msg = format!("Camera {id}: unknown type '{other}' (expected lookAt)");
+                return Err(Error::input(a.loc(p), msg));
+            }
+        };
+        if let Some(h) = c.attr("handedness").filter(|h| h.trimmed() != "right") {
+            let msg = format!(
+                "Camera {id}: handedness '{}' not supported; right-handed used",
+                h.trimmed()
+            );
+            self.notes.plain(h.loc(p), msg);
+        }
+        let position = self.req(c, "Position")?.vec3(p)?;
+        let up = self.req(c, "Up")?.vec3(p)?;
+        let near_distance = self.req(c, "NearDistance")?.float(p)?;
+        let res_node = self.req(c, "ImageResolution")?;
+        let res = res_node.ints(p)?;
+        let (width, height) = match res[..] {
+            [w, h] if w > 0 && h > 0 && w <= u32::MAX as i64 && h <= u32::MAX as i64 => {
+                (w as u32, h as u32)
+            }
+            _ => {
+                return Err(self.err(
+                    res_node,
+                    "<ImageResolution>: expected two positive integers",
+                ))
+            }
+        };
+        let name_node = self.req(c, "ImageName")?;
+        let image_name = name_node.trimmed().to_string();
+        if image_name.is_empty() {
+            return Err(self.err(name_node, "<ImageName>: empty file name"));
+        }
+        let num_samples = match self.one(c, "NumSamples") {
+            Some(n) => n.uint(p)?.max(1),
+            None => 1,
+        };
+        let (gaze, window) = if look_at {
+            let gaze = match self.one(c, "GazePoint") {
+                Some(g) => g.vec3(p)? - position,
+                None => self.req(c, "Gaze")?.vec3(p)?,
+            };
+            let fov_deg = self.req(c, "FovY")?.float(p)?;
+            let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
+            let right = top * width as f32 / height as f32;
+            (
+                gaze,
+                Window {
+                    left: -right,
+                    right,
+                    bottom: -top,
+                    top,
+                },
+            )
+        } else {
+            let gaze = self.req(c, "Gaze")?.vec3(p)?;
+            let np = self.req(c, "NearPlane")?;
+            let v = np.floats_n(4, true, p)?;
+            let extra = np.trimmed().split_whitespace().count();
+            if extra > 4 {
+                let msg = format!("<NearPlane> has {extra} numbers; only the first 4 are used");
+                self.notes.plain(np.loc(p), msg);
+            }
+            (
+                gaze,
+                Window {
+                    left: v[0],
+                    right: v[1],
+                    bottom: v[2],
+                    top: v[3],
+                },
+            )
+        };
+        if gaze.length_squared() == 0.0 {
+            return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
+        }
+        let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
+            (None, None) => None,
+            (Some(f), Some(a)) => Some(Lens {
+                aperture: a.float(p)?,
+                focus_distance: f.float(p)?,
+            }),
+            (Some(_), None) => return Err(self.err(c, "<Camera>: missing <ApertureSize>")),
+            (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
+        };
+        let transform = self.transform_of(c)?;
+        self.unsupported(c, "Tonemap", "tone mapping is");
+        self.unsupported(c, "Renderer", "path tracing is");
+        self.unsupported(c, "RendererParams", "path tracing is");
+        Ok(CameraDesc {
+            id,
+            position,
+            gaze,
+            up,
+            window,
+            near_distance,
+            orthographic: false,
+            width,
+            height,
+            image_name,
+            num_samples,
+            transform,
+            lens,
+            loc: c.loc(p),
+        })
+    }
+}

@@ -1,0 +1,272 @@
+//! The `Objects` of a METU scene: meshes (inline or from a PLY file), lone triangles, spheres, planes
+//! and mesh instances, each with its material index and object-to-world transform.
+//!
+//! Inline faces are 1-based `VertexData` ids (plus `vertexOffset`); each mesh is compacted to the
+//! vertices it uses, renumbered from 0 in order of first use, so that a scene whose meshes share one
+//! big vertex list does not copy that list into every mesh. Instances name their base mesh by id and
+//! may come before it, so they are resolved after all objects are read.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use super::Reader;
+use crate::geometry::TriangleMesh;
+use crate::math::Vec3;
+use crate::scene::tree::{Attr, Node};
+use crate::scene::{MeshSource, ObjectDesc, ShapeDesc};
+use crate::{Error, Result};
+
+/// A `MeshInstance` waiting for its base mesh; its own transform is already in its object.
+struct Pending<'n> {
+    object: usize,
+    base_id: &'n Attr,
+    reset: bool,
+    has_material: bool,
+}
+
+impl Reader<'_> {
+    /// Every object of `Objects`, in file order, then the instances' bases.
+    pub(super) fn objects(&mut self, objects: &Node) -> Result<()> {
+        let mut mesh_ids: HashMap<String, usize> = HashMap::new();
+        let mut pending = Vec::new();
+        for o in &objects.children {
+            let kind = o.name.as_str();
+            if !matches!(
+                kind,
+                "Mesh"
+                    | "LightMesh"
+                    | "Triangle"
+                    | "Sphere"
+                    | "LightSphere"
+                    | "Plane"
+                    | "MeshInstance"
+            ) {
+                continue;
+            }
+            o.mark_used();
+            let id = o.attr("id").map(|a| a.trimmed().to_string());
+            let name = format!("{kind} {}", id.as_deref().unwrap_or("(no id)"));
+            if kind.starts_with("Light") {
+                let what = "emission not supported; rendered as an ordinary object";
+                self.notes
+                    .feature(o.loc(self.path), &format!("<{kind}>"), what);
+                o.child("Radiance").map(Node::mark_subtree_used);
+            }
+            self.unsupported(o, "MotionBlur", "motion blur is");
+            self.unsupported(o, "Texture", "textures are");
+            let (material, shape) = if kind == "MeshInstance" {
+                let base_id = o
+                    .attr("baseMeshId")
+                    .ok_or_else(|| self.err(o, format!("{name}: missing attribute baseMeshId")))?;
+                let reset = match o.attr("resetTransform") {
+                    Some(a) => a.boolean(self.path)?,
+                    None => false,
+                };
+                let has_material = o.child("Material").is_some();
+                let material = if has_material {
+                    self.material_of(o, &name)?
+                } else {
+                    0
+                };
+                pending.push(Pending {
+                    object: self.desc.objects.len(),
+                    base_id,
+                    reset,
+                    has_material,
+                });
+                (material, ShapeDesc::Instance { base: 0 })
+            } else {
+                let material = self.material_of(o, &name)?;
+                (material, self.shape(o, &name)?)
+            };
+            let transform = self.transform_of(o)?;
+            if kind == "Mesh" {
+                if let Some(id) = &id {
+                    mesh_ids.insert(id.clone(), self.desc.objects.len());
+                }
+            }
+            self.desc.objects.push(ObjectDesc {
+                name,
+                material,
+                shape,
+                transform,
+                loc: o.loc(self.path),
+            });
+        }
+        for p in pending {
+            let id = p.base_id.trimmed();
+            let base = *mesh_ids.get(id).ok_or_else(|| {
+                let name = &self.desc.objects[p.object].name;
+                Error::input(
+                    p.base_id.loc(self.path),
+                    format!("{name}: unknown base mesh id '{id}'"),
+                )
+            })?;
+            let (base_transform, base_material) = {
+                let b = &self.desc.objects[base];
+                (b.transform, b.material)
+            };
+            let inst = &mut self.desc.objects[p.object];
+            inst.shape = ShapeDesc::Instance { base };
+            // Without resetTransform the instance moves the base mesh from where the base put it.
+            if !p.reset {
+                inst.transform = base_transform.then(&inst.transform);
+            }
+            if !p.has_material {
+                inst.material = base_material;
+            }
+        }
+        Ok(())
+    }
+
+    /// The geometry of `o`, any kind but `MeshInstance`.
+    fn shape(&mut self, o: &Node, name: &str) -> Result<ShapeDesc> {
+        let p = self.path;
+        Ok(match o.name.as_str() {
+            "Mesh" | "LightMesh" => {
+                let smooth = match o.attr("shadingMode") {
+                    Some(a) if a.trimmed() == "smooth" => true,
+                    Some(a) if a.trimmed() == "flat" => false,
+                    Some(a) => {
+                        let msg =
+                            format!("{name}: unknown shadingMode '{}'; flat used", a.trimmed());
+                        self.notes.plain(a.loc(p), msg);
+                        false
+                    }
+                    None => false,
+                };
+                let faces = self.req(o, "Faces")?;
+                ShapeDesc::Mesh {
+                    source: self.faces(faces, name)?,
+                    smooth,
+                }
+            }
+            "Triangle" => {
+                let ind = self.req(o, "Indices")?;
+                let idx = ind.ints(p)?;
+                if idx.len() != 3 {
+                    let msg = format!("<Indices>: expected 3 vertex ids, found {}", idx.len());
+                    return Err(self.err(ind, msg));
+                }
+                let mesh = self.compact(ind, name, &idx, 0)?;
+                ShapeDesc::Mesh {
+                    source: MeshSource::Inline(Arc::new(mesh)),
+                    smooth: false,
+                }
+            }
+            "Plane" => ShapeDesc::Plane {
+                point: self.vertex_ref(o, "Point", name)?,
+                normal: self.unit(o, "Normal")?,
+            },
+            _ => {
+                let center = self.vertex_ref(o, "Center", name)?;
+                let r = self.req(o, "Radius")?;
+                let radius = r.float(p)?;
+                if radius < 0.0 {
+                    return Err(self.err(r, format!("{name}: negative radius {radius}")));
+                }
+                ShapeDesc::Sphere { center, radius }
+            }
+        })
+    }
+
+    /// A mesh's `Faces`: a PLY file, or inline vertex ids.
+    fn faces(&mut self, faces: &Node, name: &str) -> Result<MeshSource> {
+        let p = self.path;
+        if let Some(t) = faces.attr("type").filter(|t| t.trimmed() != "triangle") {
+            let msg = format!(
+                "<Faces>: unknown type '{}' (expected triangle)",
+                t.trimmed()
+            );
+            return Err(Error::input(t.loc(p), msg));
+        }
+        if let Some(a) = faces.attr("textureOffset") {
+            let label = "attribute textureOffset of <Faces>";
+            self.notes
+                .feature(a.loc(p), label, "textures not supported; ignored");
+        }
+        if let Some(ply) = faces.attr("plyFile") {
+            if !faces.trimmed().is_empty() {
+                let msg = format!("{name}: inline faces ignored, the mesh comes from plyFile");
+                self.notes.plain(faces.loc(p), msg);
+            }
+            return Ok(MeshSource::File(self.dir.join(ply.trimmed())));
+        }
+        let offset = match faces.attr("vertexOffset") {
+            Some(a) => a.int(p)?,
+            None => 0,
+        };
+        let idx = faces.ints(p)?;
+        if idx.len() % 3 != 0 {
+            let msg = format!(
+                "<Faces>: expected vertex id triples, found {} ids",
+                idx.len()
+            );
+            return Err(self.err(faces, msg));
+        }
+        Ok(MeshSource::Inline(Arc::new(
+            self.compact(faces, name, &idx, offset)?,
+        )))
+    }
+
+    /// The triangles `idx` (1-based ids, plus `offset`) as a mesh of only the vertices they use.
+    fn compact(&self, at: &Node, name: &str, idx: &[i64], offset: i64) -> Result<TriangleMesh> {
+        let mut remap: HashMap<usize, u32> = HashMap::new();
+        let mut mesh = TriangleMesh::default();
+        let mut corners = Vec::with_capacity(idx.len());
+        for &raw in idx {
+            let v = self.vertex_index(at, name, "vertex index", raw, offset)?;
+            let next = mesh.positions.len() as u32;
+            let i = *remap.entry(v).or_insert_with(|| {
+                mesh.positions.push(self.vertices[v]);
+                next
+            });
+            corners.push(i);
+        }
+        mesh.indices = corners
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        Ok(mesh)
+    }
+
+    /// A 1-based vertex id (plus `offset`) as a 0-based index into the vertex data, or an error.
+    fn vertex_index(
+        &self,
+        at: &Node,
+        name: &str,
+        what: &str,
+        raw: i64,
+        offset: i64,
+    ) -> Result<usize> {
+        let id = raw.saturating_add(offset);
+        let n = self.vertices.len();
+        if id >= 1 && (id as u64) <= n as u64 {
+            return Ok(id as usize - 1);
+        }
+        let shown = match offset {
+            0 => raw.to_string(),
+            _ => format!("{raw} + vertexOffset {offset} = {id}"),
+        };
+        let msg = format!(
+            "{name}: {what} {shown} out of range (VertexData has {n} vertices, numbered from 1)"
+        );
+        Err(self.err(at, msg))
+    }
+
+    /// A child holding one vertex id (`Center`, `Point`), as the vertex.
+    fn vertex_ref(&mut self, o: &Node, child: &str, name: &str) -> Result<Vec3> {
+        let c = self.req(o, child)?;
+        let ids = c.ints(self.path)?;
+        let [raw] = ids[..] else {
+            let msg = format!("<{child}>: expected one vertex id, found {}", ids.len());
+            return Err(self.err(c, msg));
+        };
+        let what = if child == "Center" {
+            "centre vertex"
+        } else {
+            "point vertex"
+        };
+        Ok(self.vertices[self.vertex_index(c, name, what, raw, 0)?])
+    }
+}
