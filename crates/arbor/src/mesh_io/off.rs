@@ -1,0 +1,151 @@
+//! OFF (Object File Format) reader: a header, `nv nf ne` counts, `nv` vertex lines, `nf` face lines.
+//!
+//! Accepted: the `OFF` keyword with the usual prefixes (`COFF`, `NOFF`, `STOFF`, `CNOFF`...; their extra
+//! vertex columns, colours or normals, are ignored), counts on the keyword's line or the next one, `#`
+//! comments and blank lines anywhere, faces `n i0 i1 ... i(n-1)` with 0-based indices and optional
+//! trailing colour values, fan-triangulated. The edge count is read and ignored. Not accepted: 4-D
+//! and n-D variants (`4OFF`, `nOFF`), and the binary form (`OFF BINARY`).
+//!
+//! The counts are checked against the number of lines left before anything is allocated, since each
+//! vertex and each face takes at least one line. Cost: one pass over the bytes.
+
+use std::path::Path;
+
+use super::{count_lines, fan, parse_coord, parse_num, shown, strip_comment, too_few_vertices};
+use super::{Lines, Tokens};
+use crate::geometry::TriangleMesh;
+use crate::math::Vec3;
+use crate::{Error, Location, Result};
+
+/// Parses an OFF file already in memory; `path` is only used in error messages.
+pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
+    let mut lines = Lines::new(bytes, 1);
+    let at = |line, col| Location::at(path, line, col);
+    // Lines that hold something once comments are gone.
+    let mut next = move || {
+        while let Some((n, raw)) = lines.next() {
+            let line = strip_comment(raw);
+            if Tokens::new(line).next().is_some() {
+                return Some((n, line, lines.rest()));
+            }
+        }
+        None
+    };
+
+    let Some((hline, header, after_header)) = next() else {
+        return Err(Error::input(
+            Location::file(path),
+            "empty file (expected `OFF`)",
+        ));
+    };
+    let mut toks = Tokens::new(header);
+    let (col, kw) = toks.next().unwrap_or((1, b""));
+    check_keyword(kw).map_err(|msg| Error::input(at(hline, col), msg))?;
+    if let Some((col, b"BINARY")) = toks.clone().next() {
+        return Err(Error::input(at(hline, col), "binary OFF is not supported"));
+    }
+
+    // Counts: the rest of the keyword's line, or else the next line.
+    let (cline, mut counts_toks, rest) = if toks.clone().next().is_some() {
+        (hline, toks, after_header)
+    } else {
+        let Some((n, line, r)) = next() else {
+            let msg = "missing counts `vertices faces edges`";
+            return Err(Error::input(Location::file(path), msg));
+        };
+        (n, Tokens::new(line), r)
+    };
+    let mut count = |what: &str| -> Result<u64> {
+        let Some((col, tok)) = counts_toks.next() else {
+            let msg = format!("missing {what} count (expected `vertices faces edges`)");
+            return Err(Error::input(at(cline, counts_toks.end_col()), msg));
+        };
+        parse_num(tok, path, cline, col)
+    };
+    let nv = count("vertex")?;
+    let nf = count("face")?;
+    let left = count_lines(rest);
+    if nv.saturating_add(nf) > left {
+        let msg =
+            format!("header claims {nv} vertices and {nf} faces but only {left} lines follow");
+        return Err(Error::input(at(cline, 0), msg));
+    }
+    if nv > u64::from(u32::MAX) {
+        let msg = format!("{nv} vertices do not fit in 32-bit indices");
+        return Err(Error::input(at(cline, 0), msg));
+    }
+
+    let mut mesh = TriangleMesh {
+        positions: Vec::with_capacity(nv as usize),
+        indices: Vec::with_capacity(nf as usize),
+        ..Default::default()
+    };
+    let eof = |what: &str, i: u64, n: u64| {
+        let msg = format!("file ends after {i} of {n} {what}");
+        Error::input(Location::file(path), msg)
+    };
+    for i in 0..nv {
+        let (line, text, _) = next().ok_or_else(|| eof("vertices", i, nv))?;
+        let mut toks = Tokens::new(text);
+        let mut p = [0.0f32; 3];
+        for (k, c) in p.iter_mut().enumerate() {
+            let Some((col, tok)) = toks.next() else {
+                let msg = format!("vertex {i} has {k} coordinates, expected 3");
+                return Err(Error::input(at(line, toks.end_col()), msg));
+            };
+            *c = parse_coord(tok, path, line, col)?;
+        }
+        mesh.positions.push(Vec3::from_array(p));
+    }
+    let mut poly = Vec::new();
+    for i in 0..nf {
+        let (line, text, _) = next().ok_or_else(|| eof("faces", i, nf))?;
+        let mut toks = Tokens::new(text);
+        let (col, tok) = toks.next().unwrap_or((1, b""));
+        let n: u64 = parse_num(tok, path, line, col)?;
+        if n < 3 {
+            return Err(Error::input(
+                at(line, col),
+                too_few_vertices(&format!("face {i}"), n),
+            ));
+        }
+        poly.clear();
+        for k in 0..n {
+            let Some((col, tok)) = toks.next() else {
+                let msg = format!("face {i} lists {n} vertices but gives {k}");
+                return Err(Error::input(at(line, toks.end_col()), msg));
+            };
+            let idx: i64 = parse_num(tok, path, line, col)?;
+            if idx < 0 || idx as u64 >= nv {
+                let msg = format!(
+                    "face {i}: vertex index {idx} out of range (the file has {nv} vertices)"
+                );
+                return Err(Error::input(at(line, col), msg));
+            }
+            poly.push(idx as u32);
+        }
+        fan(&mut mesh.indices, &poly);
+    }
+    Ok(mesh)
+}
+
+/// Accepts `OFF` with the optional prefixes `ST`, `C`, `N` (in that order), in the keyword itself.
+fn check_keyword(kw: &[u8]) -> std::result::Result<(), String> {
+    let Some(prefix) = kw.strip_suffix(b"OFF") else {
+        return Err(format!(
+            "not an OFF file: expected `OFF`, found `{}`",
+            shown(kw)
+        ));
+    };
+    let mut p = prefix;
+    for part in [&b"ST"[..], b"C", b"N"] {
+        p = p.strip_prefix(part).unwrap_or(p);
+    }
+    if p.is_empty() {
+        Ok(())
+    } else if p.ends_with(b"4") || p.ends_with(b"n") {
+        Err(format!("`{}`: only 3-D OFF files are supported", shown(kw)))
+    } else {
+        Err(format!("not an OFF file: unknown keyword `{}`", shown(kw)))
+    }
+}
