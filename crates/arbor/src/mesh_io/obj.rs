@@ -115,6 +115,10 @@ impl Parser<'_> {
 
     /// One face corner `v`, `v/vt`, `v//vn` or `v/vt/vn`, resolved to 0-based indices.
     fn corner(&self, tok: &[u8], line: u32, col: u32) -> Result<[u32; 3]> {
+        if tok.iter().filter(|&&b| b == b'/').count() > 2 {
+            let msg = format!("malformed face vertex `{}`", shown(tok));
+            return Err(Error::input(Location::at(self.path, line, col), msg));
+        }
         let mut parts = tok.split(|&b| b == b'/');
         let mut out = [NONE; 3];
         let kinds = [
@@ -128,10 +132,6 @@ impl Parser<'_> {
                 Some(part) => out[k] = self.index(part, what, count, line, col)?,
                 None => break,
             }
-        }
-        if parts.next().is_some() {
-            let msg = format!("malformed face vertex `{}`", shown(tok));
-            return Err(Error::input(Location::at(self.path, line, col), msg));
         }
         Ok(out)
     }
@@ -192,5 +192,131 @@ impl Parser<'_> {
             mesh.indices.push(out);
         }
         mesh
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(src: &str) -> Result<TriangleMesh> {
+        parse_obj(src.as_bytes(), Path::new("m.obj"))
+    }
+    fn err(src: &str) -> String {
+        parse(src).unwrap_err().to_string()
+    }
+
+    const QUAD: &str =
+        "# a unit quad\nmtllib missing.mtl\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+usemtl red\ns off\nf 1 2 3 4\n";
+
+    #[test]
+    fn obj_quad_fan_triangulated() {
+        let m = parse(QUAD).unwrap();
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
+        assert!(m.normals.is_none() && m.uvs.is_none());
+    }
+
+    #[test]
+    fn obj_negative_indices_and_groups_merge() {
+        let src = "g a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\ng b\nv 5 5 5\nf 4 -2 1\n";
+        let m = parse(src).unwrap();
+        assert_eq!(m.indices, vec![[0, 1, 2], [3, 2, 0]]);
+    }
+
+    #[test]
+    fn obj_index_forms_keep_uvs_and_normals() {
+        let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n\
+f 1/1/1 2/2/1 3/3/1\nf 1/2/1 2/2/1 3/3/1\n";
+        let m = parse(src).unwrap();
+        // Vertex 1 appears with two texture coordinates: it is split.
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.indices, vec![[0, 1, 2], [3, 1, 2]]);
+        assert_eq!(m.positions[3], Vec3::ZERO);
+        assert_eq!(m.uvs.as_ref().unwrap()[3], Vec2::new(1.0, 0.0));
+        assert_eq!(m.normals, Some(vec![Vec3::Z; 4]));
+
+        let m = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n").unwrap();
+        assert!(m.uvs.is_none());
+        assert_eq!(m.normals, Some(vec![Vec3::Z; 3]));
+        let m = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1/1 2/1 3/1\n").unwrap();
+        assert_eq!(m.uvs, Some(vec![Vec2::new(0.5, 0.0); 3]));
+        assert!(m.normals.is_none());
+    }
+
+    #[test]
+    fn obj_attributes_dropped_when_some_corners_lack_them() {
+        let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 3 2 1\n";
+        let m = parse(src).unwrap();
+        assert!(m.normals.is_none());
+        assert_eq!(m.indices, vec![[0, 1, 2], [2, 1, 0]]);
+    }
+
+    #[test]
+    fn obj_malformed_number() {
+        assert_eq!(
+            err("v 0 0 0\nv 1 0.5.1 0\n"),
+            "m.obj:2:5: malformed number `0.5.1`"
+        );
+        assert_eq!(err("v 0 0 0\nf 1 x 1\n"), "m.obj:2:5: malformed number `x`");
+        assert_eq!(
+            err("v 0 0\n"),
+            "m.obj:1:6: missing number: a vertex needs x y z"
+        );
+    }
+
+    #[test]
+    fn obj_index_out_of_range() {
+        let v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        assert_eq!(
+            err(&format!("{v}f 1 2 4\n")),
+            "m.obj:4:7: vertex index 4 out of range (3 defined so far)"
+        );
+        assert_eq!(
+            err(&format!("{v}f 0 1 2\n")),
+            "m.obj:4:3: vertex index 0 out of range (3 defined so far)"
+        );
+        assert_eq!(
+            err(&format!("{v}f -4 1 2\n")),
+            "m.obj:4:3: vertex index -4 out of range (3 defined so far)"
+        );
+        assert_eq!(
+            err(&format!("{v}vt 0 0\nf 1/0 2/1 3/1\n")),
+            "m.obj:5:3: texture coordinate index 0 out of range (1 defined so far)"
+        );
+        assert_eq!(
+            err(&format!("{v}f 1//1 2//1 3//1\n")),
+            "m.obj:4:3: normal index 1 out of range (0 defined so far)"
+        );
+        assert_eq!(
+            err(&format!("{v}f 1/1/1/1 2 3\n")),
+            "m.obj:4:3: malformed face vertex `1/1/1/1`"
+        );
+    }
+
+    #[test]
+    fn obj_face_with_two_vertices() {
+        assert_eq!(
+            err("v 0 0 0\nv 1 0 0\nf 1 2\n"),
+            "m.obj:3: face has 2 vertices (a face needs at least 3)"
+        );
+    }
+
+    #[test]
+    fn obj_non_finite_coordinate() {
+        assert_eq!(err("v 0 nan 0\n"), "m.obj:1:5: non-finite coordinate `nan`");
+        assert_eq!(
+            err("vn 0 0 inf\n"),
+            "m.obj:1:8: non-finite coordinate `inf`"
+        );
+    }
+
+    #[test]
+    fn obj_crlf_comments_and_non_utf8_comments() {
+        let mut bytes = b"# caf\xe9\r\nv 0 0 0 # end\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n".to_vec();
+        bytes.extend_from_slice(b"l 1 2\r\n");
+        let m = parse_obj(&bytes, Path::new("m.obj")).unwrap();
+        assert_eq!(m.indices, vec![[0, 1, 2]]);
     }
 }

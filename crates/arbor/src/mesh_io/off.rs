@@ -149,3 +149,100 @@ fn check_keyword(kw: &[u8]) -> std::result::Result<(), String> {
         Err(format!("not an OFF file: unknown keyword `{}`", shown(kw)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(src: &str) -> Result<TriangleMesh> {
+        parse_off(src.as_bytes(), Path::new("m.off"))
+    }
+    fn err(src: &str) -> String {
+        parse(src).unwrap_err().to_string()
+    }
+
+    const SQUARE: &str = "OFF\n# a square\n4 1 4\n\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+    #[test]
+    fn off_quad_fan_triangulated() {
+        let m = parse(SQUARE).unwrap();
+        assert_eq!(m.positions[2], Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn off_counts_on_header_line_and_variants() {
+        let src = "COFF 3 1 0\n0 0 0 255 0 0 255\n1 0 0 255 0 0 255\n0 1 0 255 0 0 255\n3 0 1 2 0.5 0.5 0.5\n";
+        assert_eq!(parse(src).unwrap().indices, vec![[0, 1, 2]]);
+        let src = "NOFF\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1 # normal\n3 2 1 0\n";
+        assert_eq!(parse(src).unwrap().indices, vec![[2, 1, 0]]);
+        assert_eq!(
+            err("4OFF\n"),
+            "m.off:1:1: `4OFF`: only 3-D OFF files are supported"
+        );
+        assert_eq!(
+            err("PLY\n"),
+            "m.off:1:1: not an OFF file: expected `OFF`, found `PLY`"
+        );
+        assert_eq!(
+            err("OFF BINARY\n"),
+            "m.off:1:5: binary OFF is not supported"
+        );
+    }
+
+    #[test]
+    fn off_counts_larger_than_file_rejected() {
+        assert_eq!(
+            err("OFF\n1000000000 1 0\n0 0 0\n"),
+            "m.off:2: header claims 1000000000 vertices and 1 faces but only 1 lines follow"
+        );
+        assert_eq!(
+            err("OFF\n3\n"),
+            "m.off:2:2: missing face count (expected `vertices faces edges`)"
+        );
+    }
+
+    #[test]
+    fn off_malformed_number() {
+        let src = SQUARE.replace("1 1 0", "1 1,5 0");
+        assert_eq!(err(&src), "m.off:7:3: malformed number `1,5`");
+    }
+
+    #[test]
+    fn off_index_out_of_range() {
+        let src = SQUARE.replace("4 0 1 2 3", "4 0 1 2 4");
+        assert_eq!(
+            err(&src),
+            "m.off:9:9: face 0: vertex index 4 out of range (the file has 4 vertices)"
+        );
+        let src = SQUARE.replace("4 0 1 2 3", "4 0 -1 2 3");
+        assert_eq!(
+            err(&src),
+            "m.off:9:5: face 0: vertex index -1 out of range (the file has 4 vertices)"
+        );
+    }
+
+    #[test]
+    fn off_face_with_two_vertices() {
+        let src = SQUARE.replace("4 0 1 2 3", "2 0 1");
+        assert_eq!(
+            err(&src),
+            "m.off:9:1: face 0 has 2 vertices (a face needs at least 3)"
+        );
+        let src = SQUARE.replace("4 0 1 2 3", "4 0 1 2");
+        assert_eq!(err(&src), "m.off:9:8: face 0 lists 4 vertices but gives 3");
+    }
+
+    #[test]
+    fn off_nan_vertex_and_short_file() {
+        let src = SQUARE.replace("1 1 0", "1 NaN 0");
+        assert_eq!(err(&src), "m.off:7:3: non-finite coordinate `NaN`");
+        let src = SQUARE.replace("0 1 0\n", "0 1\n");
+        assert_eq!(
+            err(&src),
+            "m.off:8:4: vertex 3 has 2 coordinates, expected 3"
+        );
+        let src = "OFF\n3 1 0\n0 0 0\n# gone\n\n\n";
+        assert_eq!(err(src), "m.off: file ends after 1 of 3 vertices");
+    }
+}
