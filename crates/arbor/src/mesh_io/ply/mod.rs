@@ -395,6 +395,40 @@ element vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_head
     }
 
     #[test]
+    fn ply_binary_generic_vertices_and_tristrips() {
+        let header = "element vertex 4\nproperty list uchar float w\nproperty float x\n\
+property float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\n";
+        for le in [true, false] {
+            let mut w = W::new(le, header);
+            for (x, y) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                w.u8(1).f32(9.0).f32(x).f32(y).f32(0.0);
+            }
+            w.i32(4).i32(0).i32(1).i32(2).i32(3);
+            let m = parse(&w.buf).unwrap();
+            assert_eq!(m.positions[3], Vec3::new(1.0, 1.0, 0.0));
+            assert_eq!(m.indices, vec![[0, 1, 2], [2, 1, 3]]);
+        }
+    }
+
+    #[test]
+    fn ply_binary_negative_index_is_out_of_range() {
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+element face 1\nproperty list uchar int vertex_indices\n";
+        let mut w = W::new(true, header);
+        for _ in 0..9 {
+            w.f32(0.0);
+        }
+        w.u8(3).i32(0).i32(-1).i32(2);
+        let at = w.buf.len() - 8;
+        assert_eq!(
+            err(&w.buf),
+            format!(
+                "m.ply: byte {at}: face 0: vertex index -1 out of range (the file has 3 vertices)"
+            )
+        );
+    }
+
+    #[test]
     fn ply_binary_truncated_faces_name_byte_offset() {
         let mut bytes = shuffled(true);
         bytes.truncate(bytes.len() - 6);
