@@ -149,6 +149,62 @@ fn parse_errors_name_file_and_place() {
     }
 }
 
+/// Seeds for the mutation test: one valid file per reader and layout.
+fn seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let mut out: Vec<(&str, Vec<u8>)> = ["tetra.obj", "tetra.off", "square_pyramid.ply"]
+        .iter()
+        .map(|n| (*n, std::fs::read(fixture(n)).unwrap()))
+        .collect();
+    let mut bin = b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\n\
+property float y\nproperty float z\nproperty list uchar short w\nelement face 2\n\
+property list uchar int vertex_indices\nelement tristrips 1\nproperty list uint int vertex_indices\n\
+end_header\n"
+        .to_vec();
+    for v in 0..3u8 {
+        bin.extend_from_slice(&[0, 0, 0, v, 0x3f, 0x80, 0, 0, 0, 0, 0, 0, 1, 0, 7]);
+    }
+    for _ in 0..2 {
+        bin.extend_from_slice(&[3, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 2]);
+    }
+    bin.extend_from_slice(&[0, 0, 0, 3, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 0]);
+    out.push(("mutated.ply", bin));
+    out
+}
+
+#[test]
+fn mutation_seeds_are_valid() {
+    for (name, bytes) in seeds() {
+        let m = match &name[name.len() - 3..] {
+            "obj" => parse_obj(&bytes, Path::new(name)),
+            "off" => parse_off(&bytes, Path::new(name)),
+            _ => parse_ply(&bytes, Path::new(name)),
+        };
+        assert!(!m.unwrap_or_else(|e| panic!("{e}")).is_empty(), "{name}");
+    }
+}
+
+proptest::proptest! {
+    /// No input makes a reader panic: random byte changes and truncations of valid files either parse
+    /// into a valid mesh or give an error.
+    #[test]
+    fn readers_never_panic_on_mutated_input(
+        seed in 0usize..4,
+        edits in proptest::collection::vec((0usize..4096, proptest::num::u8::ANY), 0..6),
+        cut in 0usize..4096,
+    ) {
+        let (_, mut bytes) = seeds().swap_remove(seed);
+        for (pos, b) in edits {
+            let n = bytes.len();
+            bytes[pos % n] = b;
+        }
+        bytes.truncate(bytes.len() - cut % (bytes.len() / 4 + 1));
+        let p = Path::new("m");
+        for m in [parse_obj(&bytes, p), parse_off(&bytes, p), parse_ply(&bytes, p)].into_iter().flatten() {
+            assert_valid(&m, p);
+        }
+    }
+}
+
 /// Every .ply, .obj and .off file under `dir`, sorted.
 fn mesh_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
