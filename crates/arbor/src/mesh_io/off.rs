@@ -19,114 +19,140 @@ use crate::{Error, Location, Result};
 
 /// Parses an OFF file already in memory; `path` is only used in error messages.
 pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
-    let mut lines = Lines::new(bytes, 1);
-    let at = |line, col| Location::at(path, line, col);
-    // Lines that hold something once comments are gone.
-    let mut next = move || {
-        while let Some((n, raw)) = lines.next() {
-            let line = strip_comment(raw);
-            if Tokens::new(line).next().is_some() {
-                return Some((n, line, lines.rest()));
-            }
-        }
-        None
+    let mut r = Reader {
+        path,
+        lines: Lines::new(bytes, 1),
     };
-
-    let Some((hline, header, after_header)) = next() else {
-        return Err(Error::input(
-            Location::file(path),
-            "empty file (expected `OFF`)",
-        ));
-    };
-    let mut toks = Tokens::new(header);
-    let (col, kw) = toks.next().unwrap_or((1, b""));
-    check_keyword(kw).map_err(|msg| Error::input(at(hline, col), msg))?;
-    if let Some((col, b"BINARY")) = toks.clone().next() {
-        return Err(Error::input(at(hline, col), "binary OFF is not supported"));
-    }
-
-    // Counts: the rest of the keyword's line, or else the next line.
-    let (cline, mut counts_toks, rest) = if toks.clone().next().is_some() {
-        (hline, toks, after_header)
-    } else {
-        let Some((n, line, r)) = next() else {
-            let msg = "missing counts `vertices faces edges`";
-            return Err(Error::input(Location::file(path), msg));
-        };
-        (n, Tokens::new(line), r)
-    };
-    let mut count = |what: &str| -> Result<u64> {
-        let Some((col, tok)) = counts_toks.next() else {
-            let msg = format!("missing {what} count (expected `vertices faces edges`)");
-            return Err(Error::input(at(cline, counts_toks.end_col()), msg));
-        };
-        parse_num(tok, path, cline, col)
-    };
-    let nv = count("vertex")?;
-    let nf = count("face")?;
-    let left = count_lines(rest);
-    if nv.saturating_add(nf) > left {
-        let msg =
-            format!("header claims {nv} vertices and {nf} faces but only {left} lines follow");
-        return Err(Error::input(at(cline, 0), msg));
-    }
-    if nv > u64::from(u32::MAX) {
-        let msg = format!("{nv} vertices do not fit in 32-bit indices");
-        return Err(Error::input(at(cline, 0), msg));
-    }
-
+    let (nv, nf) = r.header()?;
     let mut mesh = TriangleMesh {
         positions: Vec::with_capacity(nv as usize),
         indices: Vec::with_capacity(nf as usize),
         ..Default::default()
     };
-    let eof = |what: &str, i: u64, n: u64| {
-        let msg = format!("file ends after {i} of {n} {what}");
-        Error::input(Location::file(path), msg)
-    };
     for i in 0..nv {
-        let (line, text, _) = next().ok_or_else(|| eof("vertices", i, nv))?;
+        let (line, text) = r.next().ok_or_else(|| r.eof("vertices", i, nv))?;
+        mesh.positions.push(r.vertex(i, line, text)?);
+    }
+    let mut poly = Vec::new();
+    for i in 0..nf {
+        let (line, text) = r.next().ok_or_else(|| r.eof("faces", i, nf))?;
+        r.face(i, nv, line, text, &mut poly)?;
+        fan(&mut mesh.indices, &poly);
+    }
+    Ok(mesh)
+}
+
+struct Reader<'a> {
+    path: &'a Path,
+    lines: Lines<'a>,
+}
+
+impl<'a> Reader<'a> {
+    /// The next line that holds something once comments are gone.
+    fn next(&mut self) -> Option<(u32, &'a [u8])> {
+        self.lines.find_map(|(n, raw)| {
+            let line = strip_comment(raw);
+            Tokens::new(line).next().is_some().then_some((n, line))
+        })
+    }
+
+    fn err(&self, line: u32, col: u32, msg: impl Into<String>) -> Error {
+        Error::input(Location::at(self.path, line, col), msg)
+    }
+
+    fn eof(&self, what: &str, i: u64, n: u64) -> Error {
+        let msg = format!("file ends after {i} of {n} {what}");
+        Error::input(Location::file(self.path), msg)
+    }
+
+    /// The keyword and the counts `(vertices, faces)`, checked against the lines left.
+    fn header(&mut self) -> Result<(u64, u64)> {
+        let Some((hline, header)) = self.next() else {
+            return Err(Error::input(
+                Location::file(self.path),
+                "empty file (expected `OFF`)",
+            ));
+        };
+        let mut toks = Tokens::new(header);
+        let (col, kw) = toks.next().unwrap_or((1, b""));
+        check_keyword(kw).map_err(|msg| self.err(hline, col, msg))?;
+        if let Some((col, b"BINARY")) = toks.clone().next() {
+            return Err(self.err(hline, col, "binary OFF is not supported"));
+        }
+        // Counts: the rest of the keyword's line, or else the next line.
+        let (cline, mut toks) = if toks.clone().next().is_some() {
+            (hline, toks)
+        } else {
+            let Some((n, line)) = self.next() else {
+                let msg = "missing counts `vertices faces edges`";
+                return Err(Error::input(Location::file(self.path), msg));
+            };
+            (n, Tokens::new(line))
+        };
+        let mut count = |what: &str| -> Result<u64> {
+            let Some((col, tok)) = toks.next() else {
+                let msg = format!("missing {what} count (expected `vertices faces edges`)");
+                return Err(self.err(cline, toks.end_col(), msg));
+            };
+            parse_num(tok, self.path, cline, col)
+        };
+        let (nv, nf) = (count("vertex")?, count("face")?);
+        // Each vertex and each face takes a line: reject impossible counts before allocating.
+        let left = count_lines(self.lines.rest());
+        if nv.saturating_add(nf) > left {
+            let msg =
+                format!("header claims {nv} vertices and {nf} faces but only {left} lines follow");
+            return Err(self.err(cline, 0, msg));
+        }
+        if nv > u64::from(u32::MAX) {
+            return Err(self.err(
+                cline,
+                0,
+                format!("{nv} vertices do not fit in 32-bit indices"),
+            ));
+        }
+        Ok((nv, nf))
+    }
+
+    /// `x y z`, then any extra columns (colour, normal, texture), ignored.
+    fn vertex(&self, i: u64, line: u32, text: &[u8]) -> Result<Vec3> {
         let mut toks = Tokens::new(text);
         let mut p = [0.0f32; 3];
         for (k, c) in p.iter_mut().enumerate() {
             let Some((col, tok)) = toks.next() else {
                 let msg = format!("vertex {i} has {k} coordinates, expected 3");
-                return Err(Error::input(at(line, toks.end_col()), msg));
+                return Err(self.err(line, toks.end_col(), msg));
             };
-            *c = parse_coord(tok, path, line, col)?;
+            *c = parse_coord(tok, self.path, line, col)?;
         }
-        mesh.positions.push(Vec3::from_array(p));
+        Ok(Vec3::from_array(p))
     }
-    let mut poly = Vec::new();
-    for i in 0..nf {
-        let (line, text, _) = next().ok_or_else(|| eof("faces", i, nf))?;
+
+    /// `n i0 ... i(n-1)` into `poly`, then any extra columns (colour), ignored.
+    fn face(&self, i: u64, nv: u64, line: u32, text: &[u8], poly: &mut Vec<u32>) -> Result<()> {
         let mut toks = Tokens::new(text);
         let (col, tok) = toks.next().unwrap_or((1, b""));
-        let n: u64 = parse_num(tok, path, line, col)?;
+        let n: u64 = parse_num(tok, self.path, line, col)?;
         if n < 3 {
-            return Err(Error::input(
-                at(line, col),
-                too_few_vertices(&format!("face {i}"), n),
-            ));
+            return Err(self.err(line, col, too_few_vertices(&format!("face {i}"), n)));
         }
         poly.clear();
         for k in 0..n {
             let Some((col, tok)) = toks.next() else {
                 let msg = format!("face {i} lists {n} vertices but gives {k}");
-                return Err(Error::input(at(line, toks.end_col()), msg));
+                return Err(self.err(line, toks.end_col(), msg));
             };
-            let idx: i64 = parse_num(tok, path, line, col)?;
+            let idx: i64 = parse_num(tok, self.path, line, col)?;
             if idx < 0 || idx as u64 >= nv {
                 let msg = format!(
                     "face {i}: vertex index {idx} out of range (the file has {nv} vertices)"
                 );
-                return Err(Error::input(at(line, col), msg));
+                return Err(self.err(line, col, msg));
             }
             poly.push(idx as u32);
         }
-        fan(&mut mesh.indices, &poly);
+        Ok(())
     }
-    Ok(mesh)
 }
 
 /// Accepts `OFF` with the optional prefixes `ST`, `C`, `N` (in that order), in the keyword itself.
