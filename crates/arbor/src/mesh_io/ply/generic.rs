@@ -43,34 +43,12 @@ pub(super) fn read_element<'a, S: Source<'a>>(
                 (Kind::Scalar(ty), _) => {
                     src.value(ty)?;
                 }
-                (Kind::List { count, item }, Role::Faces(j) | Role::Strips(j)) if *j == k => {
-                    let n = list_len(src, count)?;
-                    let what = if matches!(role, Role::Faces(_)) {
-                        "face"
-                    } else {
-                        "tristrips"
-                    };
-                    if what == "face" && n < 3 {
-                        let msg = too_few_vertices(&format!("face {i}"), n);
-                        return Err(Error::input(src.start(), msg));
-                    }
-                    poly.clear();
-                    for _ in 0..n {
-                        let idx = src.int(item)?;
-                        if idx == -1 && what == "tristrips" {
-                            strip(&poly, &mut out.indices);
-                            poly.clear();
-                        } else if idx < 0 || idx as u64 >= nv {
-                            return Err(index_error(what, i, idx, nv, src.here()));
-                        } else {
-                            poly.push(idx as u32);
-                        }
-                    }
-                    if what == "face" {
-                        fan(&mut out.indices, &poly);
-                    } else {
-                        strip(&poly, &mut out.indices);
-                    }
+                (Kind::List { count, item }, Role::Faces(j)) if *j == k => {
+                    read_polygon(src, (count, item), i, nv, &mut poly)?;
+                    fan(&mut out.indices, &poly);
+                }
+                (Kind::List { count, item }, Role::Strips(j)) if *j == k => {
+                    read_strips(src, (count, item), i, nv, &mut poly, &mut out.indices)?;
                 }
                 (Kind::List { count, item }, _) => {
                     for _ in 0..list_len(src, count)? {
@@ -85,6 +63,56 @@ pub(super) fn read_element<'a, S: Source<'a>>(
         }
         src.end()?;
     }
+    Ok(())
+}
+
+/// Face `i`'s index list into `poly`.
+fn read_polygon<'a, S: Source<'a>>(
+    src: &mut S,
+    (count, item): (Ty, Ty),
+    i: u64,
+    nv: u64,
+    poly: &mut Vec<u32>,
+) -> Result<()> {
+    let n = list_len(src, count)?;
+    if n < 3 {
+        let msg = too_few_vertices(&format!("face {i}"), n);
+        return Err(Error::input(src.start(), msg));
+    }
+    poly.clear();
+    for _ in 0..n {
+        let idx = src.int(item)?;
+        if idx < 0 || idx as u64 >= nv {
+            return Err(index_error("face", i, idx, nv, src.here()));
+        }
+        poly.push(idx as u32);
+    }
+    Ok(())
+}
+
+/// Entry `i` of a `tristrips` element: strips separated by -1.
+fn read_strips<'a, S: Source<'a>>(
+    src: &mut S,
+    (count, item): (Ty, Ty),
+    i: u64,
+    nv: u64,
+    strip_buf: &mut Vec<u32>,
+    out: &mut Vec<[u32; 3]>,
+) -> Result<()> {
+    strip_buf.clear();
+    for _ in 0..list_len(src, count)? {
+        match src.int(item)? {
+            -1 => {
+                strip(strip_buf, out);
+                strip_buf.clear();
+            }
+            idx if idx < 0 || idx as u64 >= nv => {
+                return Err(index_error("tristrips", i, idx, nv, src.here()));
+            }
+            idx => strip_buf.push(idx as u32),
+        }
+    }
+    strip(strip_buf, out);
     Ok(())
 }
 

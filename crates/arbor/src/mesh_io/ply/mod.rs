@@ -392,6 +392,10 @@ element vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_head
         let m = parse(src.as_bytes()).unwrap();
         // 0 1 2 3 gives (0 1 2) and (2 1 3); the strip `2 2 4` is degenerate.
         assert_eq!(m.indices, vec![[0, 1, 2], [2, 1, 3]]);
+        assert_eq!(
+            err(src.replace("2 2 4", "2 2 9").as_bytes()),
+            "m.ply:10:18: tristrips 0: vertex index 9 out of range (the file has 5 vertices)"
+        );
     }
 
     #[test]
