@@ -95,6 +95,8 @@ pub(super) struct Header {
     pub(super) body: usize,
     pub(super) body_line: u32,
 }
+const FORMATS: &str = "expected ascii, binary_little_endian or binary_big_endian";
+
 pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let err = |line, col, msg: String| Error::input(Location::at(path, line, col), msg);
     let mut lines = Lines::new(bytes, 1);
@@ -119,7 +121,7 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                     b"binary_little_endian" => Format::Le,
                     b"binary_big_endian" => Format::Be,
                     _ => {
-                        let msg = format!("unknown format `{}` (expected ascii, binary_little_endian or binary_big_endian)", shown(f));
+                        let msg = format!("unknown format `{}` ({FORMATS})", shown(f));
                         return Err(err(n, col, msg));
                     }
                 });
@@ -169,7 +171,9 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
 fn parse_property(mut toks: Tokens, path: &Path, n: u32) -> Result<Property> {
     let err = |col, msg: String| Error::input(Location::at(path, n, col), msg);
     let bad = || {
-        err(0, "malformed property line (expected `property <type> <name>` or `property list <count type> <item type> <name>`)".into())
+        let msg = "malformed property line (expected `property <type> <name>` \
+                   or `property list <count type> <item type> <name>`)";
+        err(0, msg.into())
     };
     let ty = |(col, t): (u32, &[u8])| {
         Ty::parse(t).ok_or_else(|| err(col, format!("unknown property type `{}`", shown(t))))
@@ -219,7 +223,8 @@ pub(super) fn check_sizes(h: &Header, bytes: &[u8], path: &Path) -> Result<()> {
                     e.name, e.count
                 ),
                 _ => format!(
-                    "element `{}` claims {} entries (at least {need} {unit}) but only {rest} {unit} are left for it",
+                    "element `{}` claims {} entries (at least {need} {unit}) \
+                     but only {rest} {unit} are left for it",
                     e.name, e.count
                 ),
             };

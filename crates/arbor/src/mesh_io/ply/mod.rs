@@ -585,6 +585,11 @@ property float y\nproperty float z\n";
             "m.ply:4:10: unknown property type `real`"
         );
         assert_eq!(
+            err(b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float\nend_header\n"),
+            "m.ply:4: malformed property line (expected `property <type> <name>` \
+             or `property list <count type> <item type> <name>`)"
+        );
+        assert_eq!(
             err(b"ply\nformat ascii 1.0\nproperty float x\nend_header\n"),
             "m.ply:3: property before any element"
         );
