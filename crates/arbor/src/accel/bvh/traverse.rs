@@ -6,9 +6,14 @@
 //! - ties: a node whose entry distance *equals* the best `t` is still visited, and a leaf asks each
 //!   primitive for hits up to the float just above the best `t`, keeping one at the same `t` when its
 //!   index is lower ([`Hit::beats`]);
-//! - box tests are conservative: the exit distance is enlarged by [`SLACK`] (a few hundred times pbrt's
-//!   `gamma(3)`), so rounding in the slab test can never drop a box the primitive test would hit;
-//!   visiting a box too many costs time, never correctness;
+//! - box tests are conservative. The `t` a primitive reports carries its own rounding error, and that
+//!   error is not relative to `t`: the watertight test computes `t` as a barycentric blend of the
+//!   corners' distances along the ray's major axis, so its error scales with the largest of them, which
+//!   can be far larger than `t` when the ray starts next to a big triangle. The corners lie in the box,
+//!   so that scale is bounded by the box's own slab distances on the major axis; the exit distance is
+//!   enlarged by [`SLACK`] times the larger of them. Slab rounding (pbrt's `gamma(3)`) is far smaller.
+//!   Visiting a box too many costs time, never correctness; missing one could change the closest hit,
+//!   or a tie's winner, relative to brute force;
 //! - a ray parallel to a slab with its origin exactly on the slab's plane gives `0 * inf = NaN`; `max`
 //!   and `min` ignore the NaN, which treats the ray as inside that slab, the closed-box answer.
 //!
@@ -18,19 +23,23 @@ use super::{Node, MAX_DEPTH};
 use crate::accel::{Hit, Primitives};
 use crate::math::Ray;
 
-/// Relative enlargement of a box's exit distance (2^-18, about 32 ulps).
-const SLACK: f32 = 1.0 + 1.0 / 262_144.0;
+/// Slack of the box test, relative to the box's extent in `t` along the ray's major axis (2^-16, about
+/// 128 ulps); see the module docs.
+const SLACK: f32 = 1.0 / 65_536.0;
 
 /// A ray prepared for slab tests.
 struct RayBoxTest {
     origin: [f32; 3],
     inv_dir: [f32; 3],
     negative: [bool; 3],
+    /// The axis of the direction's largest component: the one the watertight test divides by.
+    major: usize,
 }
 
 impl RayBoxTest {
     fn new(ray: &Ray) -> Self {
         let inv = ray.inv_dir;
+        let d = ray.dir.abs();
         RayBoxTest {
             origin: ray.origin.to_array(),
             inv_dir: inv.to_array(),
@@ -39,25 +48,38 @@ impl RayBoxTest {
                 inv.y.is_sign_negative(),
                 inv.z.is_sign_negative(),
             ],
+            major: if d.x > d.y && d.x > d.z {
+                0
+            } else if d.y > d.z {
+                1
+            } else {
+                2
+            },
         }
     }
 
-    /// True when the ray meets the node's box in `[0, t_far]` (conservatively).
+    /// True when the ray meets the node's box in `[0, t_far]`, conservatively.
     #[inline]
     fn hits(&self, node: &Node, t_far: f32) -> bool {
         let mut near = 0.0f32;
         let mut far = t_far;
+        let mut scale = 0.0f32;
         for a in 0..3 {
             let (enter, exit) = if self.negative[a] {
                 (node.max[a], node.min[a])
             } else {
                 (node.min[a], node.max[a])
             };
+            let t0 = (enter - self.origin[a]) * self.inv_dir[a];
+            let t1 = (exit - self.origin[a]) * self.inv_dir[a];
             // `f32::max`/`min` return the other operand when one is NaN.
-            near = near.max((enter - self.origin[a]) * self.inv_dir[a]);
-            far = far.min((exit - self.origin[a]) * self.inv_dir[a]);
+            near = near.max(t0);
+            far = far.min(t1);
+            if a == self.major {
+                scale = scale.max(t0.abs()).max(t1.abs());
+            }
         }
-        near <= far * SLACK
+        near <= far + scale * SLACK
     }
 
     /// The child to visit first (its index) and the one to push, for inner node `i`.
