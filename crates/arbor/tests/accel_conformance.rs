@@ -450,6 +450,13 @@ fn accel_matches_brute_force_on_degenerate_and_non_finite_triangles() {
         ];
         tris.push(rng.pick(&bad));
     }
+    // Slivers, long and a hair wide, whose `t` is least accurate for rays grazing them.
+    for _ in 0..60 {
+        let a = rng.vec3() * 8.0;
+        let along = (rng.vec3() - 0.5) * 10.0;
+        let across = (rng.vec3() - 0.5) * 1e-4;
+        tris.push([a, a + along, a + 0.5 * along + across]);
+    }
     let n = check_mesh("degenerates", &tris, &mut rng, DEGENERATE_RAYS);
     assert!(n >= DEGENERATE_RAYS);
 }

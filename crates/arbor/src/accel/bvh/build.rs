@@ -81,6 +81,10 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(
     prims: &P,
     params: &BvhParams,
 ) -> (Vec<Node>, Vec<u32>, usize) {
+    assert!(
+        prims.len() <= u32::MAX as usize,
+        "a BVH indexes at most 2^32 - 1 primitives"
+    );
     let all: Vec<(u32, Option<BuildPrim>)> = (0..prims.len())
         .into_par_iter()
         .map(|i| (i as u32, build_prim(prims, i)))
@@ -187,6 +191,11 @@ fn find_split(
         bins: params.bins,
     };
     let (bin, cost) = best_bin(prims, bounds, &binner, params);
+    if !cost.is_finite() {
+        // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
+        // but a range split keeps the recursion finite whatever the inputs.
+        return Some(Split::Middle { axis });
+    }
     let leaf_cost = params.intersection_cost as f64 * n as f64;
     if n <= params.max_leaf_prims && cost >= leaf_cost {
         return None;

@@ -33,8 +33,8 @@ use crate::math::{Aabb, Ray, Vec3};
 /// above it is split in the middle of its index range.
 pub const LEAF_HARD_MAX: usize = 64;
 
-/// Deepest leaf the builder produces (root at depth 0). Below [`MAX_SAH_DEPTH`] the builder stops
-/// looking for SAH splits and halves index ranges, which adds at most 32 levels.
+/// Every node's depth (root at depth 0) is below this, which sizes the traversal stack. From depth 64
+/// on the builder stops looking for SAH splits and halves index ranges, which adds at most 32 levels.
 pub const MAX_DEPTH: usize = MAX_SAH_DEPTH + 33;
 
 /// Depth after which SAH splits are no longer tried. Binned splits shrink the centroid extent by at
