@@ -5,7 +5,8 @@
 //!
 //! The cases follow Embree's verify checklist: random soups at three scales (a proptest family that
 //! shrinks to a minimal scene and ray, plus seeded loops for volume), soups offset by 1e5 and scaled by
-//! 1e-4, axis-aligned grids hit exactly on shared edges and vertices, duplicated and coplanar triangles
+//! 1e-4, axis-aligned grids hit exactly on shared edges and vertices, a closed mesh hit from inside and
+//! again from its hit points, duplicated and coplanar triangles
 //! (ties at equal `t`), degenerate and non-finite triangles, rays along the axes (with signed zeros),
 //! rays starting inside primitive boxes and exactly on their faces, triangles mixed with spheres, empty
 //! and single-primitive sets, and NaN or infinite rays. Every family declares how many rays it casts;
@@ -285,6 +286,7 @@ fn brute_force_excludes_hits_at_exactly_t_max() {
 const SOUP_RAYS: usize = 40 * 2_500 + 12 * 20_000 + 2 * 15_000;
 const SCALED_RAYS: usize = 2 * 100_000;
 const GRID_RAYS: usize = 100_000;
+const CLOSED_MESH_RAYS: usize = 50_000;
 const DUPLICATE_RAYS: usize = 100_000;
 const DEGENERATE_RAYS: usize = 80_000;
 const AXIS_RAYS: usize = 100_000;
@@ -298,6 +300,7 @@ fn conformance_casts_a_million_rays_per_structure() {
     let total = SOUP_RAYS
         + SCALED_RAYS
         + GRID_RAYS
+        + CLOSED_MESH_RAYS
         + DUPLICATE_RAYS
         + DEGENERATE_RAYS
         + AXIS_RAYS
@@ -481,6 +484,60 @@ fn accel_matches_brute_force_on_rays_along_the_axes() {
         })
         .collect();
     assert!(check("axis rays", &mesh, &probes) >= AXIS_RAYS);
+}
+
+/// The surface of the cube `[0, n]^3` as unit squares: closed, so every ray from inside hits it.
+fn closed_cube(n: u32) -> Vec<[Vec3; 3]> {
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for k in [0, n] {
+            for i in 0..n {
+                for j in 0..n {
+                    let [a, b, c, d] = [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(di, dj)| {
+                        let mut p = Vec3::ZERO;
+                        p[axis] = k as f32;
+                        p[(axis + 1) % 3] = (i + di) as f32;
+                        p[(axis + 2) % 3] = (j + dj) as f32;
+                        p
+                    });
+                    tris.extend([[a, b, c], [a, c, d]]);
+                }
+            }
+        }
+    }
+    tris
+}
+
+#[test]
+fn accel_matches_brute_force_inside_a_closed_mesh_and_from_hit_points() {
+    let mut rng = Rng::new(450);
+    let mesh = mesh_of(&closed_cube(8));
+    let inside = Aabb::new(Vec3::splat(1e-3), Vec3::splat(8.0 - 1e-3));
+    let brute = build(AccelKind::Brute, &mesh);
+    let mut probes = Vec::with_capacity(CLOSED_MESH_RAYS);
+    while probes.len() < CLOSED_MESH_RAYS {
+        // Lattice origins put some rays exactly through edges and vertices from inside.
+        let mut o = rng.in_box(&inside);
+        if rng.below(2) == 0 {
+            o = o.round().clamp(Vec3::ONE, Vec3::splat(7.0));
+        }
+        let ray = Ray::new(o, rng.vec3() - 0.5);
+        let hit = brute.intersect(&mesh, &ray, f32::INFINITY);
+        assert!(hit.is_some() || !ray.is_valid(), "{ray:?} leaked out");
+        probes.push(Probe {
+            ray,
+            t_max: f32::INFINITY,
+        });
+        // Re-intersection from the hit point: either leaves through the surface or hits it again.
+        if let Some(h) = hit {
+            let ray = Ray::new(ray.at(h.t), rng.vec3() - 0.5);
+            probes.push(Probe {
+                ray,
+                t_max: f32::INFINITY,
+            });
+        }
+    }
+    assert!(check("closed cube", &mesh, &probes) >= CLOSED_MESH_RAYS);
 }
 
 // ---------------------------------------------------------------------------------------------------
