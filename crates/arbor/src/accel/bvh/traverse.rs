@@ -99,7 +99,7 @@ impl RayBoxTest {
 /// True when no structure query can hit anything: invalid ray, empty tree, or an empty `(0, t_max)`.
 #[inline]
 fn trivially_misses(nodes: &[Node], ray: &Ray, t_max: f32) -> bool {
-    nodes.is_empty() || !ray.is_valid() || !(t_max > 0.0)
+    nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
 }
 
 /// The closest hit in `(0, t_max)`, ties to the lowest primitive index.
