@@ -7,6 +7,8 @@
 //! and lets one structure type serve triangles, spheres or whole objects.
 
 mod brute;
+pub mod bvh;
+mod mesh_prims;
 
 use std::fmt;
 use std::str::FromStr;
@@ -15,6 +17,7 @@ use std::time::Duration;
 use crate::math::{Aabb, Ray, Vec3};
 
 pub use brute::BruteForce;
+pub use bvh::{Bvh, BvhParams};
 
 /// A hit on one primitive, before its index is known.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,7 +157,7 @@ impl FromStr for AccelKind {
 pub fn build<P: Primitives + ?Sized + 'static>(kind: AccelKind, prims: &P) -> Box<dyn Accel<P>> {
     let accel: Box<dyn Accel<P>> = match kind {
         AccelKind::Brute => Box::new(BruteForce::build(prims)),
-        AccelKind::BvhSah => Box::new(BruteForce::build(prims)), // until the BVH lands
+        AccelKind::BvhSah => Box::new(Bvh::build_sah(prims, &BvhParams::default())),
     };
     #[cfg(debug_assertions)]
     if let Err(e) = accel.validate(prims) {

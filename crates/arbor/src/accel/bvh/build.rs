@@ -1,0 +1,302 @@
+//! Top-down binned SAH construction (Wald 2007; pbrt-v4's `BVHAggregate::buildRecursive`).
+//!
+//! Each node bins its primitives' centroids into `bins` equal slabs along the axis of largest centroid
+//! extent, sweeps the bins once from each side to get the cost of the `bins - 1` candidate planes,
+//!
+//! `cost(k) = traversal + intersection * (n_left * area_left + n_right * area_right) / area_node`,
+//!
+//! and partitions at the cheapest one; a node of at most `max_leaf_prims` primitives becomes a leaf when
+//! that cost is not below `intersection * n`. Nodes whose centroids all coincide, and nodes below
+//! [`MAX_SAH_DEPTH`], are split in the middle of their index range until they fit a leaf.
+//!
+//! The build works on a temporary tree of boxed nodes, then writes the flat array depth first. Large
+//! nodes build their halves with `rayon::join`; since each half owns a disjoint slice of the primitive
+//! array and every decision depends only on that slice, the result is identical for any thread count.
+//!
+//! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices and areas
+//! are computed in double precision, so centroids spanning the whole float range neither overflow nor
+//! produce NaN bins.
+
+use rayon::prelude::*;
+
+use super::{area_f64, BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
+use crate::accel::Primitives;
+use crate::math::{Aabb, Vec3};
+
+/// Nodes with at least this many primitives build their two children in parallel.
+const PARALLEL_THRESHOLD: usize = 4096;
+
+/// What the builder knows about one primitive.
+#[derive(Debug, Clone, Copy)]
+struct BuildPrim {
+    bounds: Aabb,
+    centroid: Vec3,
+    index: u32,
+}
+
+/// The temporary tree.
+enum BuildNode {
+    Leaf {
+        bounds: Aabb,
+        first: u32,
+        count: u16,
+    },
+    Inner {
+        bounds: Aabb,
+        axis: u8,
+        children: Box<[BuildNode; 2]>,
+    },
+}
+
+/// How to split a node.
+#[derive(Debug, Clone, Copy)]
+enum Split {
+    /// Primitives whose centroid falls in bins `0..=bin` go left.
+    Bin { binner: Binner, bin: usize },
+    /// The first half of the index range goes left (coincident centroids, or too deep for SAH).
+    Middle { axis: usize },
+}
+
+/// Maps centroids to bins along one axis.
+#[derive(Debug, Clone, Copy)]
+struct Binner {
+    axis: usize,
+    min: f64,
+    scale: f64,
+    bins: usize,
+}
+
+impl Binner {
+    #[inline]
+    fn bin(&self, c: Vec3) -> usize {
+        // The minimum centroid lands in bin 0 and the maximum in the last bin (the ratio rounds to
+        // `bins` or just below), so every candidate plane has primitives on both sides.
+        let k = ((c[self.axis] as f64 - self.min) * self.scale) as usize;
+        k.min(self.bins - 1)
+    }
+}
+
+/// Builds the flat node array, the reordered primitive indices and the number of primitives in the tree.
+pub(super) fn build_sah<P: Primitives + ?Sized>(
+    prims: &P,
+    params: &BvhParams,
+) -> (Vec<Node>, Vec<u32>, usize) {
+    assert!(
+        prims.len() <= u32::MAX as usize,
+        "a BVH indexes at most 2^32 - 1 primitives"
+    );
+    let all: Vec<(u32, Option<BuildPrim>)> = (0..prims.len())
+        .into_par_iter()
+        .map(|i| (i as u32, build_prim(prims, i)))
+        .collect();
+    let mut live: Vec<BuildPrim> = all.iter().filter_map(|(_, p)| *p).collect();
+    let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i);
+    let mut nodes = Vec::new();
+    if !live.is_empty() {
+        let root = build_node(&mut live, 0, 0, params);
+        nodes.reserve(count_nodes(&root));
+        flatten(&root, &mut nodes);
+    }
+    let n_live = live.len();
+    let indices = live.iter().map(|p| p.index).chain(dead).collect();
+    (nodes, indices, n_live)
+}
+
+/// The builder's view of primitive `i`, or `None` when its bounds are empty or not finite: such a
+/// primitive can never be hit, and its box would make every ancestor's box useless.
+fn build_prim<P: Primitives + ?Sized>(prims: &P, i: usize) -> Option<BuildPrim> {
+    let bounds = prims.bounds(i);
+    if bounds.is_empty() || !bounds.min.is_finite() || !bounds.max.is_finite() {
+        return None;
+    }
+    let c = prims.centroid(i);
+    // Halves before adding: the plain midpoint overflows for boxes near the float range.
+    let centroid = if c.is_finite() {
+        c
+    } else {
+        0.5 * bounds.min + 0.5 * bounds.max
+    };
+    Some(BuildPrim {
+        bounds,
+        centroid,
+        index: i as u32,
+    })
+}
+
+/// Builds the subtree over `prims`, which sit at `offset` in the final index array.
+fn build_node(
+    prims: &mut [BuildPrim],
+    offset: usize,
+    depth: usize,
+    params: &BvhParams,
+) -> BuildNode {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    let Some(split) = find_split(prims, &bounds, depth, params) else {
+        return make_leaf(bounds, offset, prims.len());
+    };
+    let (mid, axis) = partition(prims, split);
+    let (left, right) = prims.split_at_mut(mid);
+    let (l, r) = if left.len() + right.len() >= PARALLEL_THRESHOLD {
+        rayon::join(
+            || build_node(left, offset, depth + 1, params),
+            || build_node(right, offset + mid, depth + 1, params),
+        )
+    } else {
+        (
+            build_node(left, offset, depth + 1, params),
+            build_node(right, offset + mid, depth + 1, params),
+        )
+    };
+    BuildNode::Inner {
+        bounds,
+        axis: axis as u8,
+        children: Box::new([l, r]),
+    }
+}
+
+/// A leaf over `count` primitives at `offset`.
+fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode {
+    debug_assert!((1..=LEAF_HARD_MAX).contains(&count));
+    BuildNode::Leaf {
+        bounds,
+        first: offset as u32,
+        count: count as u16,
+    }
+}
+
+/// The split to make, or `None` for a leaf.
+fn find_split(
+    prims: &[BuildPrim],
+    bounds: &Aabb,
+    depth: usize,
+    params: &BvhParams,
+) -> Option<Split> {
+    let n = prims.len();
+    if n == 1 {
+        return None;
+    }
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let axis = cb.longest_axis();
+    if cb.max[axis] <= cb.min[axis] {
+        // All centroids coincide: no plane separates them. Split only to keep leaves bounded.
+        return (n > LEAF_HARD_MAX).then_some(Split::Middle { axis });
+    }
+    if depth >= MAX_SAH_DEPTH {
+        return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
+    }
+    let binner = Binner {
+        axis,
+        min: cb.min[axis] as f64,
+        scale: params.bins as f64 / (cb.max[axis] as f64 - cb.min[axis] as f64),
+        bins: params.bins,
+    };
+    let (bin, cost) = best_bin(prims, bounds, &binner, params);
+    if !cost.is_finite() {
+        // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
+        // but a range split keeps the recursion finite whatever the inputs.
+        return Some(Split::Middle { axis });
+    }
+    let leaf_cost = params.intersection_cost as f64 * n as f64;
+    if n <= params.max_leaf_prims && cost >= leaf_cost {
+        return None;
+    }
+    Some(Split::Bin { binner, bin })
+}
+
+/// The cheapest plane (after bin `k`, `k < bins - 1`) and its SAH cost.
+fn best_bin(
+    prims: &[BuildPrim],
+    bounds: &Aabb,
+    binner: &Binner,
+    params: &BvhParams,
+) -> (usize, f64) {
+    let nb = binner.bins;
+    let mut counts = [0usize; super::MAX_BINS];
+    let mut boxes = [Aabb::EMPTY; super::MAX_BINS];
+    for p in prims {
+        let k = binner.bin(p.centroid);
+        counts[k] += 1;
+        boxes[k] = boxes[k].union(p.bounds);
+    }
+    // Right-to-left sweep: count times area of everything right of each plane.
+    let mut right_cost = [0.0f64; super::MAX_BINS];
+    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    for k in (1..nb).rev() {
+        b = b.union(boxes[k]);
+        c += counts[k];
+        right_cost[k - 1] = c as f64 * area_f64(&b);
+    }
+    // A node of zero area (primitives on a line) makes every plane cost the same; the first one with
+    // primitives on both sides wins, and that is all a degenerate node needs.
+    let area = area_f64(bounds);
+    let inv_area = if area > 0.0 { 1.0 / area } else { 0.0 };
+    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    let mut best = (0usize, f64::INFINITY);
+    for k in 0..nb - 1 {
+        b = b.union(boxes[k]);
+        c += counts[k];
+        if c == 0 || c == prims.len() {
+            continue;
+        }
+        let cost = params.traversal_cost as f64
+            + params.intersection_cost as f64
+                * (c as f64 * area_f64(&b) + right_cost[k])
+                * inv_area;
+        if cost < best.1 {
+            best = (k, cost);
+        }
+    }
+    best
+}
+
+/// Reorders `prims` for `split`; returns the size of the left part (in `1..len`) and the split axis.
+fn partition(prims: &mut [BuildPrim], split: Split) -> (usize, usize) {
+    match split {
+        Split::Middle { axis } => (prims.len() / 2, axis),
+        Split::Bin { binner, bin } => {
+            // Two-pointer partition: not stable, but a pure function of the slice, so deterministic.
+            let (mut i, mut j) = (0, prims.len());
+            while i < j {
+                if binner.bin(prims[i].centroid) <= bin {
+                    i += 1;
+                } else {
+                    j -= 1;
+                    prims.swap(i, j);
+                }
+            }
+            (i, binner.axis)
+        }
+    }
+}
+
+fn count_nodes(node: &BuildNode) -> usize {
+    match node {
+        BuildNode::Leaf { .. } => 1,
+        BuildNode::Inner { children, .. } => {
+            1 + count_nodes(&children[0]) + count_nodes(&children[1])
+        }
+    }
+}
+
+/// Appends `node`'s subtree depth first (first child right after its parent); returns its index.
+fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
+    let index = out.len();
+    match node {
+        BuildNode::Leaf {
+            bounds,
+            first,
+            count,
+        } => out.push(Node::leaf(*bounds, *first, *count)),
+        BuildNode::Inner {
+            bounds,
+            axis,
+            children,
+        } => {
+            out.push(Node::inner(*bounds, 0, *axis));
+            flatten(&children[0], out);
+            let second = flatten(&children[1], out);
+            out[index] = Node::inner(*bounds, second, *axis);
+        }
+    }
+    index as u32
+}

@@ -1,0 +1,282 @@
+//! Bounding volume hierarchy: a binary tree of axis-aligned boxes over primitive indices, built top-down
+//! with the binned surface area heuristic (Wald 2007, "On fast construction of SAH-based bounding volume
+//! hierarchies"; pbrt-v4's `BVHAggregate`) and stored as one flat array of 32-byte nodes (pbrt's
+//! `LinearBVHNode`).
+//!
+//! Layout: nodes are written depth first, so an inner node's first child is the next node and only the
+//! second child's index is stored. Leaves hold a range of [`Bvh::prim_indices`], the primitive indices
+//! reordered so that every leaf's primitives are contiguous.
+//!
+//! Invariants (checked by [`Accel::validate`], which the factory runs in debug builds):
+//! - every node's box encloses its children's boxes and its primitives' boxes;
+//! - every primitive index appears exactly once in [`Bvh::prim_indices`]; the first `live` are reachable
+//!   from the root through leaves whose ranges tile `0..live` in depth-first order, the rest are
+//!   primitives with empty or non-finite bounds, which can never be hit and are left out of the tree so
+//!   that they cannot poison node boxes;
+//! - leaves hold at most [`LEAF_HARD_MAX`] primitives and the tree is at most [`MAX_DEPTH`] deep, so the
+//!   fixed-size traversal stack cannot overflow.
+//!
+//! Cost: the build is O(n log n) (one binning pass per level), with the two halves of large nodes built
+//! in parallel; the result does not depend on the thread count. A query is O(log n) on well-distributed
+//! scenes; memory is 32 bytes per node (about `2n / leaf size` nodes) plus 4 bytes per primitive.
+
+mod build;
+mod traverse;
+mod validate;
+
+use std::time::{Duration, Instant};
+
+use super::{Accel, AccelStats, Hit, Primitives};
+use crate::math::{Aabb, Ray, Vec3};
+
+/// Largest number of primitives in one leaf, whatever the parameters: a leaf of coincident centroids
+/// above it is split in the middle of its index range.
+pub const LEAF_HARD_MAX: usize = 64;
+
+/// Every node's depth (root at depth 0) is below this, which sizes the traversal stack. From depth 64
+/// on the builder stops looking for SAH splits and halves index ranges, which adds at most 32 levels.
+pub const MAX_DEPTH: usize = MAX_SAH_DEPTH + 33;
+
+/// Depth after which SAH splits are no longer tried. Binned splits shrink the centroid extent by at
+/// least one bin per level, so adversarial inputs (exponentially spaced centroids) could otherwise
+/// produce trees hundreds of levels deep.
+const MAX_SAH_DEPTH: usize = 64;
+
+/// Most bins a binned SAH build uses.
+pub const MAX_BINS: usize = 32;
+
+/// One node of the flat array: pbrt-v4's `LinearBVHNode`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
+pub struct Node {
+    /// Lower corner of the node's box.
+    pub min: [f32; 3],
+    /// Upper corner of the node's box.
+    pub max: [f32; 3],
+    /// Inner node: index of the second child (the first is the next node). Leaf: offset of its first
+    /// primitive in [`Bvh::prim_indices`].
+    pub offset: u32,
+    /// Number of primitives of a leaf; 0 marks an inner node.
+    pub count: u16,
+    /// Split axis of an inner node (0, 1, 2); traversal visits the child on the ray's side first.
+    pub axis: u8,
+    pad: u8,
+}
+
+const _: () = assert!(std::mem::size_of::<Node>() == 32);
+
+impl Node {
+    /// A leaf over `count` primitives starting at `first` in the index array.
+    pub fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
+        debug_assert!(count > 0);
+        Node {
+            min: bounds.min.to_array(),
+            max: bounds.max.to_array(),
+            offset: first,
+            count,
+            axis: 0,
+            pad: 0,
+        }
+    }
+    /// An inner node split on `axis` whose second child is node `second`.
+    pub fn inner(bounds: Aabb, second: u32, axis: u8) -> Self {
+        Node {
+            min: bounds.min.to_array(),
+            max: bounds.max.to_array(),
+            offset: second,
+            count: 0,
+            axis,
+            pad: 0,
+        }
+    }
+    /// The node's box.
+    #[inline]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(Vec3::from_array(self.min), Vec3::from_array(self.max))
+    }
+    /// True for a leaf.
+    #[inline]
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+/// Build knobs of the SAH BVH.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BvhParams {
+    /// A node with more primitives is always split; one with at most this many becomes a leaf when
+    /// splitting does not lower the SAH cost. Clamped to `1..=LEAF_HARD_MAX`.
+    pub max_leaf_prims: usize,
+    /// Number of SAH bins along the split axis. Clamped to `2..=MAX_BINS`.
+    pub bins: usize,
+    /// Cost of visiting one node, relative to `intersection_cost`.
+    pub traversal_cost: f32,
+    /// Cost of intersecting one primitive.
+    pub intersection_cost: f32,
+}
+
+impl Default for BvhParams {
+    /// 16 bins, leaves of up to 8, and pbrt-v4's cost ratio (a node visit costs half a primitive test).
+    fn default() -> Self {
+        BvhParams {
+            max_leaf_prims: 8,
+            bins: 16,
+            traversal_cost: 0.5,
+            intersection_cost: 1.0,
+        }
+    }
+}
+
+impl BvhParams {
+    /// Fewer bins and larger leaves: a quicker build for scenes rendered with few rays.
+    pub fn fast_build() -> Self {
+        BvhParams {
+            max_leaf_prims: 16,
+            bins: 12,
+            ..Self::default()
+        }
+    }
+    /// More bins and smaller leaves: a slower build for scenes rendered with many rays.
+    pub fn quality() -> Self {
+        BvhParams {
+            max_leaf_prims: 4,
+            bins: 32,
+            ..Self::default()
+        }
+    }
+    /// The parameters with every field in its valid range (NaN or negative costs become the defaults).
+    fn sanitized(&self) -> Self {
+        let d = Self::default();
+        let cost = |c: f32, dflt: f32| if c.is_finite() && c >= 0.0 { c } else { dflt };
+        BvhParams {
+            max_leaf_prims: self.max_leaf_prims.clamp(1, LEAF_HARD_MAX),
+            bins: self.bins.clamp(2, MAX_BINS),
+            traversal_cost: cost(self.traversal_cost, d.traversal_cost),
+            intersection_cost: cost(self.intersection_cost, d.intersection_cost),
+        }
+    }
+}
+
+/// A bounding volume hierarchy over primitive indices.
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    prim_indices: Vec<u32>,
+    live: usize,
+    stats: AccelStats,
+}
+
+impl Bvh {
+    /// Builds a BVH over `prims` with binned SAH splits.
+    pub fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
+        let start = Instant::now();
+        let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
+        Bvh::from_flat(nodes, prim_indices, live, "bvh-sah", start)
+    }
+
+    /// Wraps a flat node array written by any builder (the traversal and checks are shared), and
+    /// records the build time since `start`.
+    pub(crate) fn from_flat(
+        nodes: Vec<Node>,
+        prim_indices: Vec<u32>,
+        live: usize,
+        kind: &'static str,
+        start: Instant,
+    ) -> Bvh {
+        let mut bvh = Bvh {
+            nodes,
+            prim_indices,
+            live,
+            stats: AccelStats::default(),
+        };
+        bvh.stats = bvh.compute_stats(kind, start.elapsed());
+        bvh
+    }
+
+    /// The flat node array; node 0 is the root (empty when no primitive can be hit).
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// Primitive indices in leaf order; leaves refer to ranges of it.
+    pub fn prim_indices(&self) -> &[u32] {
+        &self.prim_indices
+    }
+
+    fn compute_stats(&self, kind: &'static str, build_time: Duration) -> AccelStats {
+        let mut stats = AccelStats {
+            kind,
+            primitives: self.prim_indices.len(),
+            nodes: self.nodes.len(),
+            bytes: std::mem::size_of::<Self>()
+                + self.nodes.len() * std::mem::size_of::<Node>()
+                + self.prim_indices.len() * std::mem::size_of::<u32>(),
+            build_time,
+            ..AccelStats::default()
+        };
+        let Some(root) = self.nodes.first() else {
+            return stats;
+        };
+        // Areas relative to the root's; a root of zero area (all primitives on one line or point)
+        // makes every node equally likely to be visited.
+        let root_area = area_f64(&root.bounds());
+        let rel = |n: &Node| {
+            if root_area > 0.0 {
+                area_f64(&n.bounds()) / root_area
+            } else {
+                1.0
+            }
+        };
+        let mut leaf_prims = 0usize;
+        let mut stack = vec![(0usize, 0usize)];
+        while let Some((i, depth)) = stack.pop() {
+            let n = &self.nodes[i];
+            stats.max_depth = stats.max_depth.max(depth);
+            if n.is_leaf() {
+                stats.leaves += 1;
+                leaf_prims += n.count as usize;
+                stats.sah_cost += rel(n) * n.count as f64;
+            } else {
+                stats.sah_cost += rel(n);
+                stack.push((i + 1, depth + 1));
+                stack.push((n.offset as usize, depth + 1));
+            }
+        }
+        stats.mean_leaf_prims = leaf_prims as f64 / stats.leaves as f64;
+        stats
+    }
+}
+
+/// Surface area in double precision, so that boxes near the float range do not overflow to infinity.
+fn area_f64(b: &Aabb) -> f64 {
+    if b.is_empty() {
+        return 0.0;
+    }
+    let e = b.max.as_dvec3() - b.min.as_dvec3();
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
+impl<P: Primitives + ?Sized> Accel<P> for Bvh {
+    fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, Node::bounds)
+    }
+
+    fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
+        traverse::intersect(&self.nodes, &self.prim_indices, prims, ray, t_max)
+    }
+
+    fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
+        traverse::occluded(&self.nodes, &self.prim_indices, prims, ray, t_max)
+    }
+
+    fn stats(&self) -> AccelStats {
+        self.stats.clone()
+    }
+
+    fn validate(&self, prims: &P) -> Result<(), String> {
+        validate::validate(&self.nodes, &self.prim_indices, self.live, prims)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,276 @@
+//! Unit tests of the SAH BVH: hostile inputs, determinism, structure. Equality with brute force on
+//! many rays is the job of `tests/accel_conformance.rs`.
+
+use super::*;
+use crate::accel::{build, AccelKind, BruteForce};
+use crate::geometry::TriangleMesh;
+
+/// xorshift64*: small, seeded, good enough to scatter triangles.
+struct Rng(u64);
+
+impl Rng {
+    fn f32(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn vec3(&mut self) -> Vec3 {
+        Vec3::new(self.f32(), self.f32(), self.f32())
+    }
+}
+
+fn soup(n: usize, seed: u64) -> TriangleMesh {
+    let mut rng = Rng(seed);
+    let mut mesh = TriangleMesh::default();
+    for i in 0..n {
+        let c = rng.vec3() * 10.0;
+        for _ in 0..3 {
+            mesh.positions.push(c + rng.vec3() - 0.5);
+        }
+        let k = 3 * i as u32;
+        mesh.indices.push([k, k + 1, k + 2]);
+    }
+    mesh
+}
+
+fn rays(n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5))
+        .collect()
+}
+
+fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
+    let brute = BruteForce::build(mesh);
+    for ray in rays {
+        let (a, b) = (
+            bvh.intersect(mesh, ray, f32::INFINITY),
+            brute.intersect(mesh, ray, f32::INFINITY),
+        );
+        assert_eq!(a, b, "ray {ray:?}");
+        assert_eq!(bvh.occluded(mesh, ray, 5.0), brute.occluded(mesh, ray, 5.0));
+    }
+}
+
+#[test]
+fn bvh_empty_set_hits_nothing() {
+    let mesh = TriangleMesh::default();
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    let ray = Ray::new(Vec3::ZERO, Vec3::X);
+    assert_eq!(bvh.intersect(&mesh, &ray, f32::INFINITY), None);
+    assert!(!bvh.occluded(&mesh, &ray, f32::INFINITY));
+    assert!(Accel::<TriangleMesh>::bounds(&bvh).is_empty());
+    assert_eq!(Accel::<TriangleMesh>::stats(&bvh).nodes, 0);
+}
+
+#[test]
+fn bvh_single_primitive_is_one_leaf() {
+    let mesh = soup(1, 7);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    assert_eq!(bvh.nodes().len(), 1);
+    assert!(bvh.nodes()[0].is_leaf());
+    let [a, b, c] = mesh.triangle(0);
+    let target = (a + b + c) / 3.0;
+    let ray = Ray::new(
+        target + Vec3::new(0.0, 0.0, 20.0),
+        Vec3::new(0.0, 0.0, -1.0),
+    );
+    let ray = Ray::new(ray.origin, target - ray.origin);
+    assert_eq!(
+        bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim),
+        Some(0)
+    );
+}
+
+#[test]
+fn bvh_matches_brute_force_on_small_soup() {
+    for (n, params) in [
+        (200, BvhParams::default()),
+        (300, BvhParams::fast_build()),
+        (500, BvhParams::quality()),
+    ] {
+        let mesh = soup(n, n as u64);
+        let bvh = Bvh::build_sah(&mesh, &params);
+        bvh.validate(&mesh).unwrap();
+        assert_matches_brute(&mesh, &bvh, &rays(2000, 3));
+    }
+}
+
+#[test]
+fn bvh_duplicates_at_one_point_keep_leaves_bounded() {
+    let mut mesh = soup(1, 1);
+    mesh.indices = vec![[0, 1, 2]; 1000];
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    assert!(bvh
+        .nodes()
+        .iter()
+        .all(|n| (n.count as usize) <= LEAF_HARD_MAX));
+    // Every copy is hit at the same t; the lowest index wins.
+    let [a, b, c] = mesh.triangle(0);
+    let ray = Ray::new(Vec3::splat(-5.0), (a + b + c) / 3.0 - Vec3::splat(-5.0));
+    assert_eq!(
+        bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim),
+        Some(0)
+    );
+}
+
+#[test]
+fn bvh_ties_between_leaves_go_to_the_lowest_index() {
+    // The same triangle at indices 0 and n-1, with a soup between them so that they land in
+    // different leaves; rays through it must report index 0 whatever the visiting order.
+    let mut mesh = soup(500, 11);
+    let first = mesh.indices[0];
+    mesh.indices.push(first);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    assert_matches_brute(&mesh, &bvh, &rays(3000, 5));
+    let [a, b, c] = mesh.triangle(0);
+    for o in [
+        Vec3::splat(-3.0),
+        Vec3::splat(13.0),
+        Vec3::new(13.0, -3.0, 5.0),
+    ] {
+        let ray = Ray::new(o, (a + b + c) / 3.0 - o);
+        let hit = bvh.intersect(&mesh, &ray, f32::INFINITY);
+        assert_eq!(
+            hit,
+            BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY)
+        );
+    }
+}
+
+#[test]
+fn bvh_non_finite_primitives_stay_out_of_the_tree() {
+    let mut mesh = soup(100, 2);
+    let nan = mesh.positions.len() as u32;
+    mesh.positions.push(Vec3::new(f32::NAN, 0.0, 0.0));
+    mesh.positions.push(Vec3::new(f32::INFINITY, 1.0, 1.0));
+    mesh.positions
+        .push(Vec3::new(f32::NEG_INFINITY, f32::NAN, 1.0));
+    mesh.indices.push([nan, nan + 1, nan + 2]);
+    mesh.indices.push([nan + 1, nan + 2, 0]);
+    mesh.indices.push([0, nan + 1, 1]);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    let root = bvh.nodes()[0].bounds();
+    assert!(root.min.is_finite() && root.max.is_finite());
+    assert_matches_brute(&mesh, &bvh, &rays(2000, 9));
+}
+
+#[test]
+fn bvh_flat_and_degenerate_triangles_are_handled() {
+    let mut mesh = soup(200, 4);
+    for i in 0..50 {
+        let p = Vec3::new(i as f32 * 0.1, 1.0, 2.0);
+        let k = mesh.positions.len() as u32;
+        mesh.positions.extend([p, p, p + Vec3::X]);
+        mesh.indices.push([k, k + 1, k + 2]);
+        mesh.indices.push([k, k, k]);
+    }
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    assert_matches_brute(&mesh, &bvh, &rays(2000, 8));
+}
+
+#[test]
+fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
+    // Each binned split peels off only the few largest centroids: without the depth limit the tree
+    // would be hundreds of levels deep.
+    let mut mesh = TriangleMesh::default();
+    for i in 0..2000 {
+        let x = 0.93f32.powi(i);
+        let k = mesh.positions.len() as u32;
+        mesh.positions.extend([
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x, 1.0, 0.0),
+            Vec3::new(x, 0.0, 1.0),
+        ]);
+        mesh.indices.push([k, k + 1, k + 2]);
+    }
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    let stats = Accel::<TriangleMesh>::stats(&bvh);
+    assert!(stats.max_depth < MAX_DEPTH, "{stats:?}");
+    let ray = Ray::new(Vec3::new(2.0, 0.2, 0.2), -Vec3::X);
+    let hit = bvh.intersect(&mesh, &ray, f32::INFINITY);
+    assert_eq!(
+        hit,
+        BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY)
+    );
+}
+
+#[test]
+fn bvh_build_is_identical_for_any_thread_count() {
+    let mesh = soup(20_000, 12);
+    let on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| Bvh::build_sah(&mesh, &BvhParams::default()))
+    };
+    let (one, four) = (on(1), on(4));
+    assert_eq!(one.nodes(), four.nodes());
+    assert_eq!(one.prim_indices(), four.prim_indices());
+}
+
+#[test]
+fn bvh_nan_and_zero_rays_hit_nothing() {
+    let mesh = soup(100, 3);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    for ray in [
+        Ray::new(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::X),
+        Ray::new(Vec3::splat(5.0), Vec3::new(f32::NAN, 0.0, 1.0)),
+        Ray::new(Vec3::splat(5.0), Vec3::new(f32::INFINITY, 0.0, 1.0)),
+        Ray::new(Vec3::splat(5.0), Vec3::ZERO),
+    ] {
+        assert_eq!(bvh.intersect(&mesh, &ray, f32::INFINITY), None);
+        assert!(!bvh.occluded(&mesh, &ray, f32::INFINITY));
+    }
+    let ray = Ray::new(Vec3::splat(-1.0), Vec3::ONE);
+    assert_eq!(bvh.intersect(&mesh, &ray, f32::NAN), None);
+    assert_eq!(bvh.intersect(&mesh, &ray, -1.0), None);
+}
+
+#[test]
+fn bvh_stats_describe_the_tree() {
+    let mesh = soup(10_000, 6);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let s = Accel::<TriangleMesh>::stats(&bvh);
+    assert_eq!(s.kind, "bvh-sah");
+    assert_eq!(s.primitives, 10_000);
+    assert_eq!(s.nodes, 2 * s.leaves - 1);
+    assert!(
+        s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0,
+        "{s:?}"
+    );
+    assert!(s.sah_cost > 1.0 && s.sah_cost < 10_000.0, "{s:?}");
+    assert_eq!(
+        s.bytes,
+        std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000
+    );
+}
+
+#[test]
+fn bvh_params_are_clamped() {
+    let mesh = soup(1000, 10);
+    let wild = BvhParams {
+        max_leaf_prims: 100_000,
+        bins: 0,
+        traversal_cost: f32::NAN,
+        intersection_cost: -1.0,
+    };
+    let bvh = Bvh::build_sah(&mesh, &wild);
+    bvh.validate(&mesh).unwrap();
+    assert_matches_brute(&mesh, &bvh, &rays(500, 1));
+}
+
+#[test]
+fn bvh_factory_builds_a_bvh() {
+    let mesh = soup(100, 5);
+    let accel = build(AccelKind::BvhSah, &mesh);
+    assert_eq!(accel.stats().kind, "bvh-sah");
+}

@@ -1,0 +1,206 @@
+//! Stack-based traversal of the flat node array (pbrt-v4's `BVHAggregate::Intersect`): the child on the
+//! ray's side of the split axis is visited first, the other is pushed, and a popped node is tested
+//! against the current best `t` so that nodes entirely behind the closest hit are skipped.
+//!
+//! Exactness against brute force:
+//! - ties: a node whose entry distance *equals* the best `t` is still visited, and a leaf asks each
+//!   primitive for hits up to the float just above the best `t`, keeping one at the same `t` when its
+//!   index is lower ([`Hit::beats`]);
+//! - box tests are conservative. The `t` a primitive reports carries its own rounding error, and that
+//!   error is not relative to `t`: the watertight test computes `t` as a barycentric blend of the
+//!   corners' distances along the ray's major axis, so its error scales with the largest of them, which
+//!   can be far larger than `t` when the ray starts next to a big triangle. The corners lie in the box,
+//!   so that scale is bounded by the box's own slab distances on the major axis; the exit distance is
+//!   enlarged by [`SLACK`] times the larger of them. Slab rounding (pbrt's `gamma(3)`) is far smaller.
+//!   This is an argued bound, not a proof (a grazing ray on a sliver has larger barycentric error);
+//!   the conformance suite, slivers included, still passes with 16 times less slack.
+//!   Visiting a box too many costs time, never correctness; missing one could change the closest hit,
+//!   or a tie's winner, relative to brute force;
+//! - a ray parallel to a slab with its origin exactly on the slab's plane gives `0 * inf = NaN`; `max`
+//!   and `min` ignore the NaN, which treats the ray as inside that slab, the closed-box answer.
+//!
+//! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
+
+use super::{Node, MAX_DEPTH};
+use crate::accel::{Hit, Primitives};
+use crate::math::Ray;
+
+/// Slack of the box test, relative to the box's extent in `t` along the ray's major axis (2^-16, about
+/// 128 ulps); see the module docs.
+const SLACK: f32 = 1.0 / 65_536.0;
+
+/// A ray prepared for slab tests.
+struct RayBoxTest {
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
+    negative: [bool; 3],
+    /// The axis of the direction's largest component: the one the watertight test divides by.
+    major: usize,
+}
+
+impl RayBoxTest {
+    fn new(ray: &Ray) -> Self {
+        let inv = ray.inv_dir;
+        let d = ray.dir.abs();
+        RayBoxTest {
+            origin: ray.origin.to_array(),
+            inv_dir: inv.to_array(),
+            negative: [
+                inv.x.is_sign_negative(),
+                inv.y.is_sign_negative(),
+                inv.z.is_sign_negative(),
+            ],
+            major: if d.x > d.y && d.x > d.z {
+                0
+            } else if d.y > d.z {
+                1
+            } else {
+                2
+            },
+        }
+    }
+
+    /// True when the ray meets the node's box in `[0, t_far]`, conservatively.
+    #[inline]
+    fn hits(&self, node: &Node, t_far: f32) -> bool {
+        let mut near = 0.0f32;
+        let mut far = t_far;
+        let mut scale = 0.0f32;
+        for a in 0..3 {
+            let (enter, exit) = if self.negative[a] {
+                (node.max[a], node.min[a])
+            } else {
+                (node.min[a], node.max[a])
+            };
+            let t0 = (enter - self.origin[a]) * self.inv_dir[a];
+            let t1 = (exit - self.origin[a]) * self.inv_dir[a];
+            // `f32::max`/`min` return the other operand when one is NaN.
+            near = near.max(t0);
+            far = far.min(t1);
+            if a == self.major {
+                scale = scale.max(t0.abs()).max(t1.abs());
+            }
+        }
+        near <= far + scale * SLACK
+    }
+
+    /// The child to visit first (its index) and the one to push, for inner node `i`.
+    #[inline]
+    fn order(&self, i: usize, node: &Node) -> (usize, usize) {
+        let second = node.offset as usize;
+        if self.negative[node.axis as usize] {
+            (second, i + 1)
+        } else {
+            (i + 1, second)
+        }
+    }
+}
+
+/// True when no structure query can hit anything: invalid ray, empty tree, or an empty `(0, t_max)`.
+#[inline]
+fn trivially_misses(nodes: &[Node], ray: &Ray, t_max: f32) -> bool {
+    nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
+}
+
+/// The closest hit in `(0, t_max)`, ties to the lowest primitive index.
+pub(super) fn intersect<P: Primitives + ?Sized>(
+    nodes: &[Node],
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+) -> Option<Hit> {
+    if trivially_misses(nodes, ray, t_max) {
+        return None;
+    }
+    let test = RayBoxTest::new(ray);
+    let mut best: Option<Hit> = None;
+    // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
+    let mut t_far = t_max;
+    let mut t_query = t_max;
+    let mut stack = [0u32; MAX_DEPTH];
+    let mut sp = 0;
+    let mut i = 0usize;
+    loop {
+        let node = &nodes[i];
+        if test.hits(node, t_far) {
+            if node.is_leaf() {
+                let first = node.offset as usize;
+                for &prim in &indices[first..first + node.count as usize] {
+                    if let Some(h) = prims.intersect(prim as usize, ray, t_query) {
+                        let hit = Hit::new(prim, h);
+                        if hit.beats(&best) {
+                            t_far = hit.t;
+                            t_query = next_up(hit.t);
+                            best = Some(hit);
+                        }
+                    }
+                }
+            } else {
+                let (near, far) = test.order(i, node);
+                stack[sp] = far as u32;
+                sp += 1;
+                i = near;
+                continue;
+            }
+        }
+        if sp == 0 {
+            return best;
+        }
+        sp -= 1;
+        i = stack[sp] as usize;
+    }
+}
+
+/// Whether anything is hit in `(0, t_max)`; stops at the first hit.
+pub(super) fn occluded<P: Primitives + ?Sized>(
+    nodes: &[Node],
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+) -> bool {
+    if trivially_misses(nodes, ray, t_max) {
+        return false;
+    }
+    let test = RayBoxTest::new(ray);
+    let mut stack = [0u32; MAX_DEPTH];
+    let mut sp = 0;
+    let mut i = 0usize;
+    loop {
+        let node = &nodes[i];
+        if test.hits(node, t_max) {
+            if node.is_leaf() {
+                let first = node.offset as usize;
+                let leaf = &indices[first..first + node.count as usize];
+                if leaf
+                    .iter()
+                    .any(|&p| prims.intersect(p as usize, ray, t_max).is_some())
+                {
+                    return true;
+                }
+            } else {
+                let (near, far) = test.order(i, node);
+                stack[sp] = far as u32;
+                sp += 1;
+                i = near;
+                continue;
+            }
+        }
+        if sp == 0 {
+            return false;
+        }
+        sp -= 1;
+        i = stack[sp] as usize;
+    }
+}
+
+/// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
+#[inline]
+fn next_up(t: f32) -> f32 {
+    if t.is_finite() && t >= 0.0 {
+        f32::from_bits(t.to_bits() + 1)
+    } else {
+        t
+    }
+}

@@ -1,0 +1,57 @@
+//! A [`TriangleMesh`] as a set of [`Primitives`]: primitive `i` is triangle `i`, intersected with the
+//! watertight test ([`intersect_triangle`]), so every structure over a mesh agrees with brute force on
+//! shared edges and vertices.
+//!
+//! Bounds are the box of the three corners. A corner with a NaN coordinate drops out of that box (the
+//! `min`/`max` of a NaN keeps the other operand), which is harmless: such a triangle is never hit.
+
+use super::{PrimHit, Primitives};
+use crate::geometry::{intersect_triangle, TriangleMesh};
+use crate::math::{Aabb, Ray};
+
+impl Primitives for TriangleMesh {
+    #[inline]
+    fn len(&self) -> usize {
+        TriangleMesh::len(self)
+    }
+
+    #[inline]
+    fn bounds(&self, i: usize) -> Aabb {
+        let [a, b, c] = self.triangle(i);
+        Aabb::point(a).grow(b).grow(c)
+    }
+
+    #[inline]
+    fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
+        let [a, b, c] = self.triangle(i);
+        intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit {
+            t: h.t,
+            u: h.b1,
+            v: h.b2,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    #[test]
+    fn mesh_prims_bounds_and_hit_match_the_triangle() {
+        let mesh = TriangleMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            indices: vec![[0, 1, 2]],
+            ..Default::default()
+        };
+        assert_eq!(Primitives::len(&mesh), 1);
+        assert_eq!(
+            Primitives::bounds(&mesh, 0),
+            Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))
+        );
+        let ray = Ray::new(Vec3::new(0.25, 0.25, 2.0), Vec3::new(0.0, 0.0, -1.0));
+        let h = Primitives::intersect(&mesh, 0, &ray, f32::INFINITY).unwrap();
+        assert_eq!(h.t, 2.0);
+        assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.25).abs() < 1e-6);
+    }
+}

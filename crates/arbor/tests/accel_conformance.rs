@@ -1,0 +1,718 @@
+//! The conformance suite every acceleration structure must pass: for each ray, the same hit (or none),
+//! the same primitive index, the same `t` (exactly, or within a relative 1e-6), and the same `occluded`
+//! answer as brute force. It loops over [`AccelKind::ALL`], so a new structure runs through every case
+//! here as soon as the factory knows it.
+//!
+//! The cases follow Embree's verify checklist: random soups at three scales (a proptest family that
+//! shrinks to a minimal scene and ray, plus seeded loops for volume), soups offset by 1e5 and scaled by
+//! 1e-4, axis-aligned grids hit exactly on shared edges and vertices, a closed mesh hit from inside and
+//! again from its hit points, duplicated and coplanar triangles
+//! (ties at equal `t`), degenerate and non-finite triangles, rays along the axes (with signed zeros),
+//! rays starting inside primitive boxes and exactly on their faces, triangles mixed with spheres, empty
+//! and single-primitive sets, and NaN or infinite rays. Every family declares how many rays it casts;
+//! [`conformance_casts_a_million_rays_per_structure`] keeps the total at 10^6 or more.
+
+use arbor::accel::{build, AccelKind, Hit, PrimHit, Primitives};
+use arbor::geometry::{intersect_triangle, Sphere, TriangleMesh};
+use arbor::math::{Aabb, Ray, Transform, Vec3};
+use proptest::prelude::*;
+
+// ---------------------------------------------------------------------------------------------------
+// The harness
+
+/// One query: a ray and its `t_max`.
+#[derive(Debug, Clone, Copy)]
+struct Probe {
+    ray: Ray,
+    t_max: f32,
+}
+
+/// Same hit: both none, or the same primitive at the same `t` (relative 1e-6).
+fn same_hit(a: Option<Hit>, b: Option<Hit>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            a.prim == b.prim && (a.t == b.t || (a.t - b.t).abs() <= 1e-6 * b.t.abs())
+        }
+        _ => false,
+    }
+}
+
+/// Checks every structure against brute force on `probes`; returns the number of rays cast per
+/// structure. Besides `occluded` at `t_max`, each hit at `t` is also checked with `occluded` at exactly
+/// `t` (false: the interval is open and nothing is closer) and at the next float (true). Brute force is
+/// the reference, so it is only held to those two, on every 16th ray to keep the suite fast.
+fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> usize {
+    let brute = build(AccelKind::Brute, prims);
+    let expected: Vec<_> = probes
+        .iter()
+        .map(|p| {
+            // Brute force also reports a hit at exactly `t = t_max`, outside the contract's open
+            // interval (see `brute_force_excludes_hits_at_exactly_t_max`); the contract's answer is then
+            // no hit, since nothing is closer.
+            let hit = brute
+                .intersect(prims, &p.ray, p.t_max)
+                .filter(|h| h.t < p.t_max);
+            (hit, brute.occluded(prims, &p.ray, p.t_max))
+        })
+        .collect();
+    for &kind in AccelKind::ALL {
+        let accel = build(kind, prims);
+        let is_reference = kind == AccelKind::Brute;
+        let step = if is_reference { 16 } else { 1 };
+        for (p, &(hit, occluded)) in probes.iter().zip(&expected).step_by(step) {
+            if let Some(h) = hit {
+                let t_above = f32::from_bits(h.t.to_bits() + 1);
+                let got = (
+                    accel.occluded(prims, &p.ray, h.t),
+                    accel.occluded(prims, &p.ray, t_above),
+                );
+                assert_eq!(
+                    got,
+                    (false, true),
+                    "{kind} on {case}: occluded just at and above the hit t {} {:?}",
+                    h.t,
+                    p.ray
+                );
+            }
+            if is_reference {
+                continue;
+            }
+            let got = accel.intersect(prims, &p.ray, p.t_max);
+            assert!(
+                same_hit(got, hit),
+                "{kind} on {case}: {:?} t_max {} hit {got:?}, brute force {hit:?}",
+                p.ray,
+                p.t_max
+            );
+            let got = accel.occluded(prims, &p.ray, p.t_max);
+            assert_eq!(
+                got, occluded,
+                "{kind} on {case}: occluded {:?} t_max {}",
+                p.ray, p.t_max
+            );
+        }
+    }
+    probes.len()
+}
+
+/// xorshift64*: seeded, so a failure names a reproducible case.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+    fn u32(&mut self) -> u32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 32) as u32
+    }
+    fn below(&mut self, n: usize) -> usize {
+        self.u32() as usize % n
+    }
+    /// Uniform in [0, 1).
+    fn f32(&mut self) -> f32 {
+        (self.u32() >> 8) as f32 / (1u32 << 24) as f32
+    }
+    fn vec3(&mut self) -> Vec3 {
+        Vec3::new(self.f32(), self.f32(), self.f32())
+    }
+    fn in_box(&mut self, b: &Aabb) -> Vec3 {
+        b.min + self.vec3() * (b.max - b.min)
+    }
+    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
+        xs[self.below(xs.len())]
+    }
+}
+
+fn mesh_of(tris: &[[Vec3; 3]]) -> TriangleMesh {
+    TriangleMesh {
+        positions: tris.iter().flatten().copied().collect(),
+        indices: (0..tris.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect(),
+        ..Default::default()
+    }
+}
+
+/// Points and boxes worth aiming at: primitive box corners and centres, and extra points (vertices).
+struct Targets {
+    bounds: Aabb,
+    points: Vec<Vec3>,
+    boxes: Vec<Aabb>,
+}
+
+impl Targets {
+    fn of<P: Primitives>(prims: &P, extra: &[Vec3]) -> Self {
+        let mut boxes: Vec<Aabb> = (0..prims.len())
+            .map(|i| prims.bounds(i))
+            .filter(|b| !b.is_empty() && b.min.is_finite() && b.max.is_finite())
+            .collect();
+        let mut points: Vec<Vec3> = extra.iter().copied().filter(|p| p.is_finite()).collect();
+        for b in &boxes {
+            points.extend([b.min, b.max, b.center()]);
+        }
+        let mut bounds = points.iter().fold(Aabb::EMPTY, |b, &p| b.grow(p));
+        if bounds.is_empty() {
+            bounds = Aabb::new(Vec3::splat(-1.0), Vec3::ONE);
+            points.push(Vec3::ZERO);
+        }
+        if boxes.is_empty() {
+            boxes.push(bounds);
+        }
+        Targets {
+            bounds,
+            points,
+            boxes,
+        }
+    }
+
+    /// The scene box grown by half its size on every side.
+    fn around(&self) -> Aabb {
+        let pad =
+            0.5 * self.bounds.extent() + Vec3::splat(1e-3 * self.bounds.max.abs().max_element());
+        Aabb::new(self.bounds.min - pad, self.bounds.max + pad)
+    }
+
+    /// A ray of a random flavour; see the module docs.
+    fn probe(&self, rng: &mut Rng) -> Probe {
+        let around = self.around();
+        let (origin, dir) = match rng.below(6) {
+            // Aimed at a corner, centre or vertex: grazes edges and ties on shared vertices.
+            0 => {
+                let o = rng.in_box(&around);
+                (o, rng.pick(&self.points) - o)
+            }
+            1 => (rng.in_box(&around), rng.vec3() - 0.5),
+            // Along an axis through a target point's lines: exactly on edges of axis-aligned geometry.
+            2 => {
+                let mut o = rng.pick(&self.points);
+                let axis = rng.below(3);
+                o[axis] = rng.in_box(&around)[axis];
+                (o, signed_axis(rng, axis))
+            }
+            // From inside a primitive's box.
+            3 => {
+                let b = rng.pick(&self.boxes);
+                (rng.in_box(&b), rng.vec3() - 0.5)
+            }
+            // From a face of a primitive's box, sometimes parallel to that face.
+            4 => {
+                let b = rng.pick(&self.boxes);
+                let mut o = rng.in_box(&b);
+                let axis = rng.below(3);
+                o[axis] = if rng.below(2) == 0 {
+                    b.min[axis]
+                } else {
+                    b.max[axis]
+                };
+                let mut d = rng.vec3() - 0.5;
+                if rng.below(2) == 0 {
+                    d[axis] = if rng.below(2) == 0 { 0.0 } else { -0.0 };
+                }
+                (o, d)
+            }
+            // From a vertex or corner itself (re-intersection from a hit point).
+            _ => (rng.pick(&self.points), rng.vec3() - 0.5),
+        };
+        let t_max = if rng.below(5) == 0 {
+            rng.f32() * 2.0 * around.extent().length() / dir.length().max(1e-30)
+        } else {
+            f32::INFINITY
+        };
+        Probe {
+            ray: Ray::new(origin, dir),
+            t_max,
+        }
+    }
+
+    fn probes(&self, rng: &mut Rng, n: usize) -> Vec<Probe> {
+        (0..n).map(|_| self.probe(rng)).collect()
+    }
+}
+
+/// A unit direction along `axis`, either sign, with the other components +0 or -0 (their reciprocals
+/// are +inf or -inf, which slab tests must treat alike).
+fn signed_axis(rng: &mut Rng, axis: usize) -> Vec3 {
+    let mut d = Vec3::ZERO;
+    for a in 0..3 {
+        d[a] = if rng.below(2) == 0 { 0.0 } else { -0.0 };
+    }
+    d[axis] = if rng.below(2) == 0 { 1.0 } else { -1.0 };
+    d
+}
+
+fn random_soup(rng: &mut Rng, n: usize, extent: f32, tri_size: f32) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|_| {
+            let c = rng.vec3() * extent;
+            [0; 3].map(|_| c + (rng.vec3() - 0.5) * tri_size)
+        })
+        .collect()
+}
+
+/// Checks a mesh made of `tris` with `n` random probes aimed at its vertices and boxes.
+fn check_mesh(case: &str, tris: &[[Vec3; 3]], rng: &mut Rng, n: usize) -> usize {
+    let mesh = mesh_of(tris);
+    let vertices: Vec<Vec3> = tris.iter().flatten().copied().collect();
+    let probes = Targets::of(&mesh, &vertices).probes(rng, n);
+    check(case, &mesh, &probes)
+}
+
+/// The contract's interval is open: a hit at exactly `t_max` does not count. Brute force's `intersect`
+/// starts its search at `t_max.next_up()` and keeps hits with `t <= t_max`, so it reports them (its
+/// `occluded` does not). Ignored until `accel/brute.rs` is fixed; `check` filters such hits meanwhile.
+#[test]
+#[ignore = "accel/brute.rs reports hits at exactly t = t_max"]
+fn brute_force_excludes_hits_at_exactly_t_max() {
+    let tri = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let mesh = mesh_of(&[tri]);
+    let ray = Ray::new(Vec3::new(0.0, 0.0, 2.0), Vec3::new(0.0, 0.0, -1.0));
+    let brute = build(AccelKind::Brute, &mesh);
+    let t = brute.intersect(&mesh, &ray, f32::INFINITY).unwrap().t;
+    assert_eq!(brute.intersect(&mesh, &ray, t), None);
+    assert!(!brute.occluded(&mesh, &ray, t));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Ray budget: each family casts at least this many rays per structure.
+
+const SOUP_RAYS: usize = 40 * 2_500 + 12 * 20_000 + 2 * 15_000;
+const SCALED_RAYS: usize = 2 * 100_000;
+const GRID_RAYS: usize = 100_000;
+const CLOSED_MESH_RAYS: usize = 50_000;
+const DUPLICATE_RAYS: usize = 100_000;
+const DEGENERATE_RAYS: usize = 80_000;
+const AXIS_RAYS: usize = 100_000;
+const MIXED_RAYS: usize = 100_000;
+const TINY_SET_RAYS: usize = 3 * 10_000;
+const NAN_RAYS: usize = 8 * 9;
+/// Not counted: about 9k rays (192 cases of 1 to 95), but the number varies with the generated cases.
+const PROPTEST_RAYS: usize = 0;
+
+#[test]
+fn conformance_casts_a_million_rays_per_structure() {
+    let total = SOUP_RAYS
+        + SCALED_RAYS
+        + GRID_RAYS
+        + CLOSED_MESH_RAYS
+        + DUPLICATE_RAYS
+        + DEGENERATE_RAYS
+        + AXIS_RAYS
+        + MIXED_RAYS
+        + TINY_SET_RAYS
+        + NAN_RAYS
+        + PROPTEST_RAYS;
+    assert!(total >= 1_000_000, "only {total} rays per structure");
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Triangle soups
+
+#[test]
+fn accel_matches_brute_force_on_random_soups_at_three_scales() {
+    let mut rays = 0;
+    for seed in 0..40 {
+        let mut rng = Rng::new(seed);
+        let n = 1 + rng.below(24);
+        let tris = random_soup(&mut rng, n, 4.0, 1.5);
+        rays += check_mesh("small soup", &tris, &mut rng, 2_500);
+    }
+    for seed in 0..12 {
+        let mut rng = Rng::new(100 + seed);
+        let tris = random_soup(&mut rng, 300, 20.0, 2.0);
+        rays += check_mesh("medium soup", &tris, &mut rng, 20_000);
+    }
+    for seed in 0..2 {
+        let mut rng = Rng::new(200 + seed);
+        let tris = random_soup(&mut rng, 4_000, 100.0, 3.0);
+        rays += check_mesh("large soup", &tris, &mut rng, 15_000);
+    }
+    assert!(rays >= SOUP_RAYS);
+}
+
+#[test]
+fn accel_matches_brute_force_on_offset_and_scaled_soups() {
+    let mut rays = 0;
+    for (case, map) in [
+        (
+            "soup offset by 1e5",
+            (|p: Vec3| p + Vec3::splat(1e5)) as fn(Vec3) -> Vec3,
+        ),
+        ("soup scaled by 1e-4", |p: Vec3| p * 1e-4),
+    ] {
+        for seed in 0..4 {
+            let mut rng = Rng::new(300 + seed);
+            let tris: Vec<_> = random_soup(&mut rng, 250, 10.0, 1.5)
+                .into_iter()
+                .map(|t| t.map(map))
+                .collect();
+            rays += check_mesh(case, &tris, &mut rng, 25_000);
+        }
+    }
+    assert!(rays >= SCALED_RAYS);
+}
+
+/// Unit squares (two triangles each) on the integer planes `x = k`, `y = k` and `z = k`: neighbours
+/// share edges exactly, and the planes of different families cross along the same lines.
+fn grid(cells: u32, planes: u32) -> Vec<[Vec3; 3]> {
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        let frame = |k: u32, i: u32, j: u32| {
+            let mut p = Vec3::ZERO;
+            p[axis] = k as f32;
+            p[(axis + 1) % 3] = i as f32;
+            p[(axis + 2) % 3] = j as f32;
+            p
+        };
+        for k in 0..planes {
+            for i in 0..cells {
+                for j in 0..cells {
+                    let [a, b, c, d] = [(0, 0), (1, 0), (1, 1), (0, 1)]
+                        .map(|(di, dj)| frame(2 * k, i + di, j + dj));
+                    tris.push([a, b, c]);
+                    tris.push([a, c, d]);
+                }
+            }
+        }
+    }
+    tris
+}
+
+#[test]
+fn accel_matches_brute_force_on_axis_aligned_grids() {
+    let tris = grid(6, 4);
+    let mut rng = Rng::new(400);
+    let mesh = mesh_of(&tris);
+    // Origins and targets on the half-integer lattice: rays run exactly along edges and through
+    // vertices, where two to six triangles tie.
+    let lattice = |rng: &mut Rng| (rng.vec3() * 16.0 - 2.0).map(|x| (x * 2.0).round() / 2.0);
+    let mut probes = Vec::with_capacity(GRID_RAYS);
+    let targets = Targets::of(&mesh, &tris.concat());
+    while probes.len() < GRID_RAYS {
+        let o = lattice(&mut rng);
+        let dir = match rng.below(3) {
+            0 => lattice(&mut rng) - o,
+            1 => {
+                let axis = rng.below(3);
+                signed_axis(&mut rng, axis)
+            }
+            _ => {
+                probes.push(targets.probe(&mut rng));
+                continue;
+            }
+        };
+        probes.push(Probe {
+            ray: Ray::new(o, dir),
+            t_max: f32::INFINITY,
+        });
+    }
+    assert!(check("grid", &mesh, &probes) >= GRID_RAYS);
+}
+
+#[test]
+fn accel_matches_brute_force_on_duplicated_and_coplanar_triangles() {
+    let mut rng = Rng::new(500);
+    let mut tris = random_soup(&mut rng, 60, 6.0, 2.0);
+    // Copies at random indices, so that the lowest-index rule is exercised across leaves.
+    for _ in 0..120 {
+        let t = rng.pick(&tris);
+        let at = rng.below(tris.len() + 1);
+        tris.insert(at, t);
+    }
+    // Overlapping triangles in the planes z = 1 and z = 3: equal t on every overlap.
+    for _ in 0..80 {
+        let z = if rng.below(2) == 0 { 1.0 } else { 3.0 };
+        let c = rng.vec3() * 6.0;
+        tris.push([0; 3].map(|_| (c + (rng.vec3() - 0.5) * 3.0).with_z(z)));
+    }
+    assert!(check_mesh("duplicates", &tris, &mut rng, DUPLICATE_RAYS) >= DUPLICATE_RAYS);
+}
+
+#[test]
+fn accel_matches_brute_force_on_degenerate_and_non_finite_triangles() {
+    let mut rng = Rng::new(600);
+    let mut tris = random_soup(&mut rng, 100, 8.0, 2.0);
+    for _ in 0..150 {
+        let a = rng.vec3() * 8.0;
+        let b = rng.vec3() * 8.0;
+        let bad = [
+            [a, a, b],                                             // two equal corners
+            [a, 0.5 * (a + b), b],                                 // collinear
+            [a; 3],                                                // a point
+            [a, a + Vec3::X * 1e-30, a + Vec3::Y * 1e-30],         // far below float spacing
+            [a, b, Vec3::new(f32::NAN, a.y, a.z)],                 // NaN corner
+            [a, b, Vec3::new(a.x, f32::INFINITY, a.z)],            // infinite corner
+            [Vec3::splat(f32::NAN); 3],                            // nothing at all
+            [a, Vec3::splat(-1e30), Vec3::new(1e30, -1e30, 1e30)], // huge
+        ];
+        tris.push(rng.pick(&bad));
+    }
+    // Slivers, long and a hair wide, whose `t` is least accurate for rays grazing them.
+    for _ in 0..60 {
+        let a = rng.vec3() * 8.0;
+        let along = (rng.vec3() - 0.5) * 10.0;
+        let across = (rng.vec3() - 0.5) * 1e-4;
+        tris.push([a, a + along, a + 0.5 * along + across]);
+    }
+    let n = check_mesh("degenerates", &tris, &mut rng, DEGENERATE_RAYS);
+    assert!(n >= DEGENERATE_RAYS);
+}
+
+#[test]
+fn accel_matches_brute_force_on_rays_along_the_axes() {
+    let mut rng = Rng::new(700);
+    let tris = random_soup(&mut rng, 300, 10.0, 2.0);
+    let mesh = mesh_of(&tris);
+    let targets = Targets::of(&mesh, &tris.concat());
+    let probes: Vec<_> = (0..AXIS_RAYS)
+        .map(|_| {
+            // Two coordinates from a vertex or box corner: the ray meets it, or runs along a box face.
+            let mut o = rng.pick(&targets.points);
+            let axis = rng.below(3);
+            let around = targets.around();
+            o[axis] = rng.in_box(&around)[axis];
+            Probe {
+                ray: Ray::new(o, signed_axis(&mut rng, axis)),
+                t_max: f32::INFINITY,
+            }
+        })
+        .collect();
+    assert!(check("axis rays", &mesh, &probes) >= AXIS_RAYS);
+}
+
+/// The surface of the cube `[0, n]^3` as unit squares: closed, so every ray from inside hits it.
+fn closed_cube(n: u32) -> Vec<[Vec3; 3]> {
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for k in [0, n] {
+            for i in 0..n {
+                for j in 0..n {
+                    let [a, b, c, d] = [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(di, dj)| {
+                        let mut p = Vec3::ZERO;
+                        p[axis] = k as f32;
+                        p[(axis + 1) % 3] = (i + di) as f32;
+                        p[(axis + 2) % 3] = (j + dj) as f32;
+                        p
+                    });
+                    tris.extend([[a, b, c], [a, c, d]]);
+                }
+            }
+        }
+    }
+    tris
+}
+
+#[test]
+fn accel_matches_brute_force_inside_a_closed_mesh_and_from_hit_points() {
+    let mut rng = Rng::new(450);
+    let mesh = mesh_of(&closed_cube(8));
+    let inside = Aabb::new(Vec3::splat(1e-3), Vec3::splat(8.0 - 1e-3));
+    let brute = build(AccelKind::Brute, &mesh);
+    let mut probes = Vec::with_capacity(CLOSED_MESH_RAYS);
+    while probes.len() < CLOSED_MESH_RAYS {
+        // Lattice origins put some rays exactly through edges and vertices from inside.
+        let mut o = rng.in_box(&inside);
+        if rng.below(2) == 0 {
+            o = o.round().clamp(Vec3::ONE, Vec3::splat(7.0));
+        }
+        let ray = Ray::new(o, rng.vec3() - 0.5);
+        let hit = brute.intersect(&mesh, &ray, f32::INFINITY);
+        assert!(hit.is_some() || !ray.is_valid(), "{ray:?} leaked out");
+        probes.push(Probe {
+            ray,
+            t_max: f32::INFINITY,
+        });
+        // Re-intersection from the hit point: either leaves through the surface or hits it again.
+        if let Some(h) = hit {
+            let ray = Ray::new(ray.at(h.t), rng.vec3() - 0.5);
+            probes.push(Probe {
+                ray,
+                t_max: f32::INFINITY,
+            });
+        }
+    }
+    assert!(check("closed cube", &mesh, &probes) >= CLOSED_MESH_RAYS);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Triangles and spheres together
+
+/// A mixed set, the shape of a top-level structure over objects.
+enum Shape {
+    Triangle([Vec3; 3]),
+    Sphere(Sphere),
+}
+
+struct Shapes(Vec<Shape>);
+
+impl Primitives for Shapes {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn bounds(&self, i: usize) -> Aabb {
+        match &self.0[i] {
+            Shape::Triangle(t) => Aabb::from_points(*t),
+            Shape::Sphere(s) => s.bounds(),
+        }
+    }
+    fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
+        match &self.0[i] {
+            Shape::Triangle([a, b, c]) => {
+                intersect_triangle(ray, *a, *b, *c, t_max).map(|h| PrimHit {
+                    t: h.t,
+                    u: h.b1,
+                    v: h.b2,
+                })
+            }
+            Shape::Sphere(s) => s
+                .intersect(ray, t_max)
+                .map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+        }
+    }
+}
+
+#[test]
+fn accel_matches_brute_force_on_triangles_mixed_with_spheres() {
+    let mut rng = Rng::new(800);
+    let mut shapes: Vec<Shape> = random_soup(&mut rng, 150, 10.0, 2.0)
+        .into_iter()
+        .map(Shape::Triangle)
+        .collect();
+    for i in 0..80 {
+        let center = rng.vec3() * 10.0;
+        // Some ellipsoids, some duplicates of the previous sphere (ties between spheres).
+        let transform = match i % 4 {
+            0 => Transform::scale(Vec3::new(2.0, 0.5, 1.0)).unwrap(),
+            _ => Transform::IDENTITY,
+        };
+        let sphere = Sphere {
+            center,
+            radius: 0.05 + rng.f32(),
+            transform,
+        };
+        let at = rng.below(shapes.len() + 1);
+        shapes.insert(at, Shape::Sphere(sphere));
+        if i % 8 == 1 {
+            shapes.push(Shape::Sphere(sphere));
+        }
+    }
+    let shapes = Shapes(shapes);
+    let probes = Targets::of(&shapes, &[]).probes(&mut rng, MIXED_RAYS);
+    assert!(check("triangles and spheres", &shapes, &probes) >= MIXED_RAYS);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Tiny sets and invalid rays
+
+#[test]
+fn accel_matches_brute_force_on_empty_and_single_primitive_sets() {
+    let mut rng = Rng::new(900);
+    let empty = TriangleMesh::default();
+    let probes = Targets::of(&empty, &[]).probes(&mut rng, 10_000);
+    let mut rays = check("empty set", &empty, &probes);
+    let tri = [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.0, 0.0, 3.0),
+    ];
+    rays += check_mesh("one triangle", &[tri], &mut rng, 10_000);
+    let sphere = Shapes(vec![Shape::Sphere(Sphere {
+        center: Vec3::new(1.0, 2.0, 3.0),
+        radius: 0.5,
+        transform: Transform::IDENTITY,
+    })]);
+    let probes = Targets::of(&sphere, &[]).probes(&mut rng, 10_000);
+    rays += check("one sphere", &sphere, &probes);
+    assert!(rays >= TINY_SET_RAYS);
+}
+
+#[test]
+fn accel_nan_and_infinite_rays_hit_nothing() {
+    let mut rng = Rng::new(1000);
+    let tris = random_soup(&mut rng, 200, 5.0, 2.0);
+    let mesh = mesh_of(&tris);
+    let (nan, inf) = (f32::NAN, f32::INFINITY);
+    let good_o = Vec3::splat(-1.0);
+    let good_d = Vec3::ONE;
+    let origins = [
+        Vec3::new(nan, 1.0, 1.0),
+        Vec3::new(1.0, inf, 1.0),
+        Vec3::new(1.0, 1.0, -inf),
+        Vec3::splat(nan),
+    ];
+    let dirs = [
+        Vec3::new(nan, 1.0, 1.0),
+        Vec3::new(inf, 0.0, 0.0),
+        Vec3::new(1.0, -inf, 1.0),
+        Vec3::ZERO,
+    ];
+    let mut rays: Vec<Ray> = origins.iter().map(|&o| Ray::new(o, good_d)).collect();
+    rays.extend(dirs.iter().map(|&d| Ray::new(good_o, d)));
+    let mut probes = Vec::new();
+    for ray in rays {
+        for t_max in [
+            inf,
+            10.0,
+            nan,
+            0.0,
+            -1.0,
+            -inf,
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            1e-30,
+        ] {
+            probes.push(Probe { ray, t_max });
+        }
+    }
+    // A valid ray under an invalid t_max must miss too.
+    let valid = Ray::new(good_o, good_d);
+    for t_max in [nan, 0.0, -1.0, -inf] {
+        probes.push(Probe { ray: valid, t_max });
+    }
+    let n = check("invalid rays", &mesh, &probes);
+    assert!(n >= NAN_RAYS);
+    let brute = build(AccelKind::Brute, &mesh);
+    for p in &probes {
+        assert_eq!(brute.intersect(&mesh, &p.ray, p.t_max), None, "{p:?}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Property test: small soups on a coarse lattice (shared vertices, coplanar faces and equal-t ties are
+// common), shrunk to a minimal failing scene and ray.
+
+fn lattice_point() -> impl Strategy<Value = Vec3> {
+    prop::array::uniform3(-12i32..=12)
+        .prop_map(|[x, y, z]| Vec3::new(x as f32, y as f32, z as f32) / 4.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(192))]
+
+    #[test]
+    fn accel_matches_brute_force_on_lattice_soups(
+        tris in prop::collection::vec(prop::array::uniform3(lattice_point()), 0..48),
+        rays in prop::collection::vec((lattice_point(), lattice_point(), 0u8..4), 1..96),
+    ) {
+        let mesh = mesh_of(&tris);
+        let probes: Vec<Probe> = rays
+            .iter()
+            .map(|&(o, target, mode)| {
+                let dir = match mode {
+                    0 => Vec3::X,
+                    1 => -Vec3::Z,
+                    _ => target - o,
+                };
+                Probe { ray: Ray::new(o, dir), t_max: if mode == 3 { 1.0 } else { f32::INFINITY } }
+            })
+            .collect();
+        check("lattice soup", &mesh, &probes);
+    }
+}
