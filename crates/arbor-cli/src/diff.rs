@@ -25,9 +25,9 @@ pub struct DiffArgs {
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
     let c = compare_files(&args.reference, &args.image, args.threshold)?;
-    println!("{}", c.summary());
+    say!("{}", c.summary());
     if c.share_off * 100.0 > args.max_off {
-        println!(
+        say!(
             "FAIL: {:.3}% of pixels off by more than {} levels (limit {}%)",
             c.share_off * 100.0,
             args.threshold,
@@ -35,7 +35,7 @@ pub fn run(args: DiffArgs) -> Result<(), Failure> {
         );
         return Err(Failure::TooDifferent);
     }
-    println!(
+    say!(
         "OK: {:.3}% of pixels off by more than {} levels (limit {}%)",
         c.share_off * 100.0,
         args.threshold,

@@ -21,13 +21,13 @@ pub struct InfoArgs {
 /// Runs `arbor info`.
 pub fn run(args: InfoArgs) -> Result<(), Failure> {
     let desc = crate::render::read_scene(&args.scene)?;
-    println!("scene      {}", crate::shown(&args.scene));
-    println!(
+    say!("scene      {}", crate::shown(&args.scene));
+    say!(
         "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",
         desc.background, desc.ambient, desc.max_depth, desc.shadow_epsilon
     );
     for c in &desc.cameras {
-        println!(
+        say!(
             "camera {}   {}x{}  {} spp  -> {}{}",
             c.id,
             c.width,
@@ -40,13 +40,13 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     for l in &desc.lights {
         match l {
             LightDesc::Point { position, intensity } => {
-                println!("light      point at {position}, intensity {intensity}")
+                say!("light      point at {position}, intensity {intensity}")
             }
             LightDesc::Area { position, size, radiance, .. } => {
-                println!("light      area {size}x{size} at {position}, radiance {radiance}")
+                say!("light      area {size}x{size} at {position}, radiance {radiance}")
             }
             LightDesc::Directional { direction, radiance } => {
-                println!("light      directional along {direction}, radiance {radiance}")
+                say!("light      directional along {direction}, radiance {radiance}")
             }
         }
     }
@@ -58,7 +58,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             MaterialKind::Dielectric { .. } => "dielectric",
             MaterialKind::Transparent { .. } => "transparent (legacy)",
         };
-        println!("material {}  {kind}", m.id);
+        say!("material {}  {kind}", m.id);
     }
     for o in &desc.objects {
         let what = match &o.shape {
@@ -72,14 +72,14 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             ShapeDesc::Plane { .. } => "plane".to_string(),
             ShapeDesc::Instance { base } => format!("instance of {}", desc.objects[*base].name),
         };
-        println!("object     {}: {what}", o.name);
+        say!("object     {}: {what}", o.name);
     }
     for w in &desc.warnings {
-        println!("warning    {w}");
+        say!("warning    {w}");
     }
     let scene = Scene::build(desc, args.accel, None)?;
     let g = &scene.geometry.counts;
-    println!(
+    say!(
         "geometry   {} triangles ({} degenerate), {} spheres, {} planes; bounds {} .. {}; meshes read in {:.1} ms",
         g.triangles,
         g.degenerate,
@@ -90,7 +90,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         g.mesh_load.as_secs_f64() * 1e3
     );
     let s = scene.geometry.accel_stats();
-    println!(
+    say!(
         "structure  {}: {} nodes, {} leaves, max depth {}, {:.2} primitives per leaf, SAH cost {:.2}, {} KiB, built in {:.1} ms",
         s.kind,
         s.nodes,

@@ -3,6 +3,12 @@
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
 //! 4 I/O failure.
 
+/// Prints a line to standard output. A closed pipe (`arbor info | head -1`) ends the program quietly
+/// instead of panicking, as command-line tools do.
+macro_rules! say {
+    ($($arg:tt)*) => { $crate::say_line(format_args!($($arg)*)) };
+}
+
 mod diff;
 mod info;
 mod render;
@@ -41,6 +47,17 @@ pub enum Failure {
 impl From<arbor::Error> for Failure {
     fn from(e: arbor::Error) -> Self {
         Failure::Arbor(e)
+    }
+}
+
+/// The body of [`say!`].
+pub fn say_line(args: std::fmt::Arguments) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|_| out.write_all(b"\n")) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
     }
 }
 

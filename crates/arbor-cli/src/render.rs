@@ -72,7 +72,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let parse_time = t0.elapsed();
     for w in &desc.warnings {
         if !args.quiet {
-            eprintln!("warning: {w}");
+            esay!("warning: {w}");
         }
     }
     let cameras: Vec<usize> = match &args.camera {
@@ -115,7 +115,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         arbor::image_io::write_image(&path, &film)?;
         if !args.quiet {
             let g = &scene.geometry.counts;
-            println!(
+            say!(
                 "{}  {}x{}  {} spp  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
                  render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
                 path.display(),

@@ -9,33 +9,16 @@ use arbor::math::Vec3;
 use arbor::mesh_io::{load_mesh, parse_obj, parse_off, parse_ply};
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/meshes")
-        .join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes").join(name)
 }
 
 /// What every loaded mesh must satisfy, whatever the format.
 fn assert_valid(m: &TriangleMesh, what: &Path) {
     let n = m.positions.len() as u32;
-    assert!(
-        m.indices.iter().flatten().all(|&i| i < n),
-        "{}",
-        what.display()
-    );
-    assert!(
-        m.positions.iter().all(|p| p.is_finite()),
-        "{}",
-        what.display()
-    );
-    for attr in [
-        m.normals.as_ref().map(Vec::len),
-        m.uvs.as_ref().map(Vec::len),
-    ] {
-        assert!(
-            attr.is_none_or(|l| l == m.positions.len()),
-            "{}",
-            what.display()
-        );
+    assert!(m.indices.iter().flatten().all(|&i| i < n), "{}", what.display());
+    assert!(m.positions.iter().all(|p| p.is_finite()), "{}", what.display());
+    for attr in [m.normals.as_ref().map(Vec::len), m.uvs.as_ref().map(Vec::len)] {
+        assert!(attr.is_none_or(|l| l == m.positions.len()), "{}", what.display());
     }
 }
 
@@ -81,10 +64,7 @@ fn load_mesh_missing_file_is_io_error() {
 fn load_mesh_unknown_extension_is_input_error() {
     let err = load_mesh(Path::new("models/teapot.stl")).unwrap_err();
     assert!(!err.is_io());
-    assert_eq!(
-        err.to_string(),
-        "models/teapot.stl: unknown mesh file extension `.stl` (supported: .ply, .obj, .off)"
-    );
+    assert_eq!(err.to_string(), "models/teapot.stl: unknown mesh file extension `.stl` (supported: .ply, .obj, .off)");
 }
 
 /// A binary PLY built here, in both byte orders, written to disk and loaded back.
@@ -212,9 +192,7 @@ fn mesh_files(dir: &Path) -> Vec<PathBuf> {
     while let Some(d) = stack.pop() {
         for entry in std::fs::read_dir(&d).unwrap() {
             let path = entry.unwrap().path();
-            let ext = path
-                .extension()
-                .map(|e| e.to_string_lossy().to_ascii_lowercase());
+            let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
             if path.is_dir() {
                 stack.push(path);
             } else if matches!(ext.as_deref(), Some("ply" | "obj" | "off")) {
@@ -265,15 +243,9 @@ fn real_scene_meshes_load_with_known_triangle_counts() {
         ("nyu-cg-assignment4/Assignment_4/data/dodeca.off", 36),
         ("ceng795-2019/inputs/hw2/ply/cube.ply", 12),
         ("ceng795-2019/inputs/hw2/ply/tap_tap.ply", 10_484),
-        (
-            "ceng795-2019/inputs/hw2/ply/tap_water_200.ply",
-            39_660 + 2 * 80,
-        ),
+        ("ceng795-2019/inputs/hw2/ply/tap_water_200.ply", 39_660 + 2 * 80),
         ("ceng795-2019/inputs/hw5/ply/plane.ply", 2),
-        (
-            "ceng795-2024-hw1/hw1/inputs/akif_uslu/ton_Roosendaal_smooth_ply/mesh_2.ply",
-            62_160,
-        ),
+        ("ceng795-2024-hw1/hw1/inputs/akif_uslu/ton_Roosendaal_smooth_ply/mesh_2.ply", 62_160),
     ];
     let mut ton_total = 0;
     let files = mesh_files(&dir);
@@ -290,10 +262,7 @@ fn real_scene_meshes_load_with_known_triangle_counts() {
             ton_total += m.len();
         }
     }
-    if files
-        .iter()
-        .any(|p| p.to_string_lossy().contains("ceng795-2024-hw1"))
-    {
+    if files.iter().any(|p| p.to_string_lossy().contains("ceng795-2024-hw1")) {
         assert_eq!(ton_total, 78_620);
     }
 }

@@ -41,17 +41,14 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
+        // Ascending order with a strictly shrinking limit: a later primitive at the same `t` has a higher
+        // index and is rightly refused, so ties go to the lowest index.
         let mut best: Option<Hit> = None;
-        let mut t_best = t_max;
+        let mut limit = t_max;
         for i in 0..self.len {
-            // `<=` keeps candidates at the current best t, so that ties resolve to the lowest index
-            // whatever the order; ascending order makes the first one found win.
-            if let Some(h) = prims.intersect(i, ray, t_best.next_up_or_inf()) {
-                let hit = Hit::new(i as u32, h);
-                if hit.t <= t_best && hit.beats(&best) {
-                    t_best = hit.t;
-                    best = Some(hit);
-                }
+            if let Some(h) = prims.intersect(i, ray, limit) {
+                limit = h.t;
+                best = Some(Hit::new(i as u32, h));
             }
         }
         best
@@ -70,25 +67,5 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
             return Err(format!("built over {} primitives, queried with {}", self.len, prims.len()));
         }
         Ok(())
-    }
-}
-
-/// `next_up` for positive floats, stable in Rust 1.86; spelled out for older toolchains.
-trait NextUp {
-    fn next_up_or_inf(self) -> Self;
-}
-
-impl NextUp for f32 {
-    #[inline]
-    fn next_up_or_inf(self) -> f32 {
-        if self.is_infinite() || self.is_nan() {
-            self
-        } else if self == 0.0 {
-            f32::from_bits(1)
-        } else if self > 0.0 {
-            f32::from_bits(self.to_bits() + 1)
-        } else {
-            f32::from_bits(self.to_bits() - 1)
-        }
     }
 }

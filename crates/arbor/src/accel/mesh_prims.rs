@@ -24,11 +24,7 @@ impl Primitives for TriangleMesh {
     #[inline]
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
         let [a, b, c] = self.triangle(i);
-        intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit {
-            t: h.t,
-            u: h.b1,
-            v: h.b2,
-        })
+        intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit { t: h.t, u: h.b1, v: h.b2 })
     }
 }
 
@@ -45,10 +41,7 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(Primitives::len(&mesh), 1);
-        assert_eq!(
-            Primitives::bounds(&mesh, 0),
-            Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))
-        );
+        assert_eq!(Primitives::bounds(&mesh, 0), Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
         let ray = Ray::new(Vec3::new(0.25, 0.25, 2.0), Vec3::new(0.0, 0.0, -1.0));
         let h = Primitives::intersect(&mesh, 0, &ray, f32::INFINITY).unwrap();
         assert_eq!(h.t, 2.0);

@@ -1,6 +1,7 @@
-//! Axis-aligned bounding boxes and the slab test.
+//! Axis-aligned bounding boxes. (The ray-box test lives with the traversal that needs its exact
+//! conservativeness: `accel::bvh`.)
 
-use super::{Ray, Vec3};
+use super::Vec3;
 
 /// An axis-aligned box. The empty box has `min = +inf`, `max = -inf`, so that `union` needs no branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,18 +86,5 @@ impl Aabb {
     #[inline]
     pub fn contains(&self, o: &Aabb) -> bool {
         o.is_empty() || (self.min.cmple(o.min).all() && self.max.cmpge(o.max).all())
-    }
-    /// Slab test: the entry distance when the ray meets the box within `(0, t_max)`.
-    ///
-    /// Uses `min`/`max` on the reciprocal direction so that NaN from `0 * inf` drops out (the
-    /// comparison with a NaN keeps the other operand), following Williams et al. 2005.
-    #[inline]
-    pub fn hit(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        let t0 = (self.min - ray.origin) * ray.inv_dir;
-        let t1 = (self.max - ray.origin) * ray.inv_dir;
-        let near = t0.min(t1).max_element().max(0.0);
-        let far = t0.max(t1).min_element().min(t_max);
-        // Enlarge `far` by two ulps-ish (pbrt's gamma(3)) so that rays grazing a flat box are kept.
-        (near <= far * (1.0 + 2.0 * f32::EPSILON * 3.0)).then_some(near)
     }
 }

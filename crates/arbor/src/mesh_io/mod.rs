@@ -32,9 +32,7 @@ const SUPPORTED: &str = "supported: .ply, .obj, .off";
 ///
 /// An unknown or missing extension is an input error; a file that cannot be read is an I/O error.
 pub fn load_mesh(path: &Path) -> Result<TriangleMesh> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let parse: fn(&[u8], &Path) -> Result<TriangleMesh> = match ext.as_deref() {
         Some("ply") => parse_ply,
         Some("obj") => parse_obj,
@@ -65,11 +63,7 @@ pub(crate) struct Lines<'a> {
 impl<'a> Lines<'a> {
     /// Lines of `bytes`, the first numbered `first_line`.
     pub(crate) fn new(bytes: &'a [u8], first_line: u32) -> Self {
-        Lines {
-            rest: bytes,
-            next_line: first_line,
-            done: bytes.is_empty(),
-        }
+        Lines { rest: bytes, next_line: first_line, done: bytes.is_empty() }
     }
     /// The number the next line will get.
     pub(crate) fn next_number(&self) -> u32 {
@@ -139,10 +133,7 @@ impl<'a> Iterator for Tokens<'a> {
     fn next(&mut self) -> Option<Self::Item> {
         let is_space = |b: &u8| b.is_ascii_whitespace() || *b == 0x0b;
         let start = self.pos + self.line[self.pos..].iter().position(|b| !is_space(b))?;
-        let len = self.line[start..]
-            .iter()
-            .position(is_space)
-            .unwrap_or(self.line.len() - start);
+        let len = self.line[start..].iter().position(is_space).unwrap_or(self.line.len() - start);
         self.pos = start + len;
         Some((col(start), &self.line[start..self.pos]))
     }
@@ -163,13 +154,10 @@ pub(crate) fn shown(tok: &[u8]) -> String {
 
 /// Parses a number token, or says where and what it is.
 pub(crate) fn parse_num<T: FromStr>(tok: &[u8], path: &Path, line: u32, col: u32) -> Result<T> {
-    std::str::from_utf8(tok)
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .ok_or_else(|| {
-            let msg = format!("malformed number `{}`", shown(tok));
-            Error::input(Location::at(path, line, col), msg)
-        })
+    std::str::from_utf8(tok).ok().and_then(|s| s.parse().ok()).ok_or_else(|| {
+        let msg = format!("malformed number `{}`", shown(tok));
+        Error::input(Location::at(path, line, col), msg)
+    })
 }
 
 /// Parses a coordinate: a number that must also be finite (`nan`, `inf` and overflowing values like
@@ -238,14 +226,8 @@ mod tests {
     #[test]
     fn load_mesh_rejects_unknown_extension() {
         let e = load_mesh(Path::new("scene/model.stl")).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "scene/model.stl: unknown mesh file extension `.stl` (supported: .ply, .obj, .off)"
-        );
+        assert_eq!(e.to_string(), "scene/model.stl: unknown mesh file extension `.stl` (supported: .ply, .obj, .off)");
         let e = load_mesh(Path::new("model")).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "model: mesh file has no extension (supported: .ply, .obj, .off)"
-        );
+        assert_eq!(e.to_string(), "model: mesh file has no extension (supported: .ply, .obj, .off)");
     }
 }

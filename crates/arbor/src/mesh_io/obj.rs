@@ -121,11 +121,8 @@ impl Parser<'_> {
         }
         let mut parts = tok.split(|&b| b == b'/');
         let mut out = [NONE; 3];
-        let kinds = [
-            ("vertex", self.positions.len()),
-            ("texture coordinate", self.uvs.len()),
-            ("normal", self.normals.len()),
-        ];
+        let kinds =
+            [("vertex", self.positions.len()), ("texture coordinate", self.uvs.len()), ("normal", self.normals.len())];
         for (k, &(what, count)) in kinds.iter().enumerate() {
             match parts.next() {
                 Some(b"") if k > 0 => {}
@@ -155,11 +152,7 @@ impl Parser<'_> {
         let keep_normal = self.all_normal && !self.tris.is_empty();
         if !keep_uv && !keep_normal {
             return TriangleMesh {
-                indices: self
-                    .tris
-                    .iter()
-                    .map(|t| [t[0][0], t[1][0], t[2][0]])
-                    .collect(),
+                indices: self.tris.iter().map(|t| [t[0][0], t[1][0], t[2][0]]).collect(),
                 positions: self.positions,
                 normals: None,
                 uvs: None,
@@ -167,11 +160,8 @@ impl Parser<'_> {
         }
         // One output vertex per distinct (position, uv, normal) triple actually used.
         let mut map: HashMap<[u32; 3], u32> = HashMap::new();
-        let mut mesh = TriangleMesh {
-            normals: keep_normal.then(Vec::new),
-            uvs: keep_uv.then(Vec::new),
-            ..Default::default()
-        };
+        let mut mesh =
+            TriangleMesh { normals: keep_normal.then(Vec::new), uvs: keep_uv.then(Vec::new), ..Default::default() };
         mesh.indices.reserve(self.tris.len());
         for tri in &self.tris {
             let mut out = [0; 3];
@@ -206,8 +196,7 @@ mod tests {
         parse(src).unwrap_err().to_string()
     }
 
-    const QUAD: &str =
-        "# a unit quad\nmtllib missing.mtl\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+    const QUAD: &str = "# a unit quad\nmtllib missing.mtl\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
 usemtl red\ns off\nf 1 2 3 4\n";
 
     #[test]
@@ -255,61 +244,34 @@ f 1/1/1 2/2/1 3/3/1\nf 1/2/1 2/2/1 3/3/1\n";
 
     #[test]
     fn obj_malformed_number() {
-        assert_eq!(
-            err("v 0 0 0\nv 1 0.5.1 0\n"),
-            "m.obj:2:5: malformed number `0.5.1`"
-        );
+        assert_eq!(err("v 0 0 0\nv 1 0.5.1 0\n"), "m.obj:2:5: malformed number `0.5.1`");
         assert_eq!(err("v 0 0 0\nf 1 x 1\n"), "m.obj:2:5: malformed number `x`");
-        assert_eq!(
-            err("v 0 0\n"),
-            "m.obj:1:6: missing number: a vertex needs x y z"
-        );
+        assert_eq!(err("v 0 0\n"), "m.obj:1:6: missing number: a vertex needs x y z");
     }
 
     #[test]
     fn obj_index_out_of_range() {
         let v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
-        assert_eq!(
-            err(&format!("{v}f 1 2 4\n")),
-            "m.obj:4:7: vertex index 4 out of range (3 defined so far)"
-        );
-        assert_eq!(
-            err(&format!("{v}f 0 1 2\n")),
-            "m.obj:4:3: vertex index 0 out of range (3 defined so far)"
-        );
-        assert_eq!(
-            err(&format!("{v}f -4 1 2\n")),
-            "m.obj:4:3: vertex index -4 out of range (3 defined so far)"
-        );
+        assert_eq!(err(&format!("{v}f 1 2 4\n")), "m.obj:4:7: vertex index 4 out of range (3 defined so far)");
+        assert_eq!(err(&format!("{v}f 0 1 2\n")), "m.obj:4:3: vertex index 0 out of range (3 defined so far)");
+        assert_eq!(err(&format!("{v}f -4 1 2\n")), "m.obj:4:3: vertex index -4 out of range (3 defined so far)");
         assert_eq!(
             err(&format!("{v}vt 0 0\nf 1/0 2/1 3/1\n")),
             "m.obj:5:3: texture coordinate index 0 out of range (1 defined so far)"
         );
-        assert_eq!(
-            err(&format!("{v}f 1//1 2//1 3//1\n")),
-            "m.obj:4:3: normal index 1 out of range (0 defined so far)"
-        );
-        assert_eq!(
-            err(&format!("{v}f 1/1/1/1 2 3\n")),
-            "m.obj:4:3: malformed face vertex `1/1/1/1`"
-        );
+        assert_eq!(err(&format!("{v}f 1//1 2//1 3//1\n")), "m.obj:4:3: normal index 1 out of range (0 defined so far)");
+        assert_eq!(err(&format!("{v}f 1/1/1/1 2 3\n")), "m.obj:4:3: malformed face vertex `1/1/1/1`");
     }
 
     #[test]
     fn obj_face_with_two_vertices() {
-        assert_eq!(
-            err("v 0 0 0\nv 1 0 0\nf 1 2\n"),
-            "m.obj:3: face has 2 vertices (a face needs at least 3)"
-        );
+        assert_eq!(err("v 0 0 0\nv 1 0 0\nf 1 2\n"), "m.obj:3: face has 2 vertices (a face needs at least 3)");
     }
 
     #[test]
     fn obj_non_finite_coordinate() {
         assert_eq!(err("v 0 nan 0\n"), "m.obj:1:5: non-finite coordinate `nan`");
-        assert_eq!(
-            err("vn 0 0 inf\n"),
-            "m.obj:1:8: non-finite coordinate `inf`"
-        );
+        assert_eq!(err("vn 0 0 inf\n"), "m.obj:1:8: non-finite coordinate `inf`");
     }
 
     #[test]

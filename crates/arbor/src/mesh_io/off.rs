@@ -19,10 +19,7 @@ use crate::{Error, Location, Result};
 
 /// Parses an OFF file already in memory; `path` is only used in error messages.
 pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
-    let mut r = Reader {
-        path,
-        lines: Lines::new(bytes, 1),
-    };
+    let mut r = Reader { path, lines: Lines::new(bytes, 1) };
     let (nv, nf) = r.header()?;
     let mut mesh = TriangleMesh {
         positions: Vec::with_capacity(nv as usize),
@@ -68,10 +65,7 @@ impl<'a> Reader<'a> {
     /// The keyword and the counts `(vertices, faces)`, checked against the lines left.
     fn header(&mut self) -> Result<(u64, u64)> {
         let Some((hline, header)) = self.next() else {
-            return Err(Error::input(
-                Location::file(self.path),
-                "empty file (expected `OFF`)",
-            ));
+            return Err(Error::input(Location::file(self.path), "empty file (expected `OFF`)"));
         };
         let mut toks = Tokens::new(header);
         let (col, kw) = toks.next().unwrap_or((1, b""));
@@ -100,16 +94,11 @@ impl<'a> Reader<'a> {
         // Each vertex and each face takes a line: reject impossible counts before allocating.
         let left = count_lines(self.lines.rest());
         if nv.saturating_add(nf) > left {
-            let msg =
-                format!("header claims {nv} vertices and {nf} faces but only {left} lines follow");
+            let msg = format!("header claims {nv} vertices and {nf} faces but only {left} lines follow");
             return Err(self.err(cline, 0, msg));
         }
         if nv > u64::from(u32::MAX) {
-            return Err(self.err(
-                cline,
-                0,
-                format!("{nv} vertices do not fit in 32-bit indices"),
-            ));
+            return Err(self.err(cline, 0, format!("{nv} vertices do not fit in 32-bit indices")));
         }
         Ok((nv, nf))
     }
@@ -144,9 +133,7 @@ impl<'a> Reader<'a> {
             };
             let idx: i64 = parse_num(tok, self.path, line, col)?;
             if idx < 0 || idx as u64 >= nv {
-                let msg = format!(
-                    "face {i}: vertex index {idx} out of range (the file has {nv} vertices)"
-                );
+                let msg = format!("face {i}: vertex index {idx} out of range (the file has {nv} vertices)");
                 return Err(self.err(line, col, msg));
             }
             poly.push(idx as u32);
@@ -158,10 +145,7 @@ impl<'a> Reader<'a> {
 /// Accepts `OFF` with the optional prefixes `ST`, `C`, `N` (in that order), in the keyword itself.
 fn check_keyword(kw: &[u8]) -> std::result::Result<(), String> {
     let Some(prefix) = kw.strip_suffix(b"OFF") else {
-        return Err(format!(
-            "not an OFF file: expected `OFF`, found `{}`",
-            shown(kw)
-        ));
+        return Err(format!("not an OFF file: expected `OFF`, found `{}`", shown(kw)));
     };
     let mut p = prefix;
     for part in [&b"ST"[..], b"C", b"N"] {
@@ -202,18 +186,9 @@ mod tests {
         assert_eq!(parse(src).unwrap().indices, vec![[0, 1, 2]]);
         let src = "NOFF\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1 # normal\n3 2 1 0\n";
         assert_eq!(parse(src).unwrap().indices, vec![[2, 1, 0]]);
-        assert_eq!(
-            err("4OFF\n"),
-            "m.off:1:1: `4OFF`: only 3-D OFF files are supported"
-        );
-        assert_eq!(
-            err("PLY\n"),
-            "m.off:1:1: not an OFF file: expected `OFF`, found `PLY`"
-        );
-        assert_eq!(
-            err("OFF BINARY\n"),
-            "m.off:1:5: binary OFF is not supported"
-        );
+        assert_eq!(err("4OFF\n"), "m.off:1:1: `4OFF`: only 3-D OFF files are supported");
+        assert_eq!(err("PLY\n"), "m.off:1:1: not an OFF file: expected `OFF`, found `PLY`");
+        assert_eq!(err("OFF BINARY\n"), "m.off:1:5: binary OFF is not supported");
     }
 
     #[test]
@@ -222,10 +197,7 @@ mod tests {
             err("OFF\n1000000000 1 0\n0 0 0\n"),
             "m.off:2: header claims 1000000000 vertices and 1 faces but only 1 lines follow"
         );
-        assert_eq!(
-            err("OFF\n3\n"),
-            "m.off:2:2: missing face count (expected `vertices faces edges`)"
-        );
+        assert_eq!(err("OFF\n3\n"), "m.off:2:2: missing face count (expected `vertices faces edges`)");
     }
 
     #[test]
@@ -237,24 +209,15 @@ mod tests {
     #[test]
     fn off_index_out_of_range() {
         let src = SQUARE.replace("4 0 1 2 3", "4 0 1 2 4");
-        assert_eq!(
-            err(&src),
-            "m.off:9:9: face 0: vertex index 4 out of range (the file has 4 vertices)"
-        );
+        assert_eq!(err(&src), "m.off:9:9: face 0: vertex index 4 out of range (the file has 4 vertices)");
         let src = SQUARE.replace("4 0 1 2 3", "4 0 -1 2 3");
-        assert_eq!(
-            err(&src),
-            "m.off:9:5: face 0: vertex index -1 out of range (the file has 4 vertices)"
-        );
+        assert_eq!(err(&src), "m.off:9:5: face 0: vertex index -1 out of range (the file has 4 vertices)");
     }
 
     #[test]
     fn off_face_with_two_vertices() {
         let src = SQUARE.replace("4 0 1 2 3", "2 0 1");
-        assert_eq!(
-            err(&src),
-            "m.off:9:1: face 0 has 2 vertices (a face needs at least 3)"
-        );
+        assert_eq!(err(&src), "m.off:9:1: face 0 has 2 vertices (a face needs at least 3)");
         let src = SQUARE.replace("4 0 1 2 3", "4 0 1 2");
         assert_eq!(err(&src), "m.off:9:8: face 0 lists 4 vertices but gives 3");
     }
@@ -264,10 +227,7 @@ mod tests {
         let src = SQUARE.replace("1 1 0", "1 NaN 0");
         assert_eq!(err(&src), "m.off:7:3: non-finite coordinate `NaN`");
         let src = SQUARE.replace("0 1 0\n", "0 1\n");
-        assert_eq!(
-            err(&src),
-            "m.off:8:4: vertex 3 has 2 coordinates, expected 3"
-        );
+        assert_eq!(err(&src), "m.off:8:4: vertex 3 has 2 coordinates, expected 3");
         let src = "OFF\n3 1 0\n0 0 0\n# gone\n\n\n";
         assert_eq!(err(src), "m.off: file ends after 1 of 3 vertices");
     }

@@ -66,12 +66,7 @@ pub fn parse_value(text: &str, path: &Path) -> Result<Spanned> {
         return Err(Error::input(loc, format!("JSON syntax error: {msg}")));
     }
     let mut s = Scanner::new(text);
-    let v = s.value().map_err(|()| {
-        Error::input(
-            Location::at(path, s.line, s.col),
-            "JSON value not understood",
-        )
-    })?;
+    let v = s.value().map_err(|()| Error::input(Location::at(path, s.line, s.col), "JSON value not understood"))?;
     Ok(v)
 }
 
@@ -104,19 +99,13 @@ pub fn top_level_keys(text: &str) -> Option<Vec<String>> {
 pub fn parse(text: &str, path: &Path) -> Result<Node> {
     let doc = parse_value(text, path)?;
     let Value::Object(members) = &doc.value else {
-        return Err(Error::input(
-            Location::at(path, doc.line, doc.col),
-            "expected a JSON object holding \"Scene\"",
-        ));
+        return Err(Error::input(Location::at(path, doc.line, doc.col), "expected a JSON object holding \"Scene\""));
     };
     let mut root = Node::new("", doc.line, doc.col);
     add_members(&mut root, members, path)?;
     let scene_at = root.children.iter().rposition(|c| c.name == "Scene");
     let Some(i) = scene_at else {
-        return Err(Error::input(
-            Location::at(path, doc.line, doc.col),
-            "no top-level \"Scene\" object",
-        ));
+        return Err(Error::input(Location::at(path, doc.line, doc.col), "no top-level \"Scene\" object"));
     };
     let mut scene = root.children.remove(i);
     // Other top-level keys have no meaning; keeping them as children of Scene gets them reported
@@ -134,12 +123,10 @@ fn add_members(node: &mut Node, members: &[Member], path: &Path) -> Result<()> {
             node.attrs.push(Attr::new(name, v, m.line, m.col));
         } else if let Value::Array(items) = &m.value.value {
             for it in items {
-                node.children
-                    .push(element(&m.key, it, it.line, it.col, path)?);
+                node.children.push(element(&m.key, it, it.line, it.col, path)?);
             }
         } else {
-            node.children
-                .push(element(&m.key, &m.value, m.line, m.col, path)?);
+            node.children.push(element(&m.key, &m.value, m.line, m.col, path)?);
         }
     }
     Ok(())
@@ -191,13 +178,7 @@ type Scan<T> = std::result::Result<T, ()>;
 
 impl<'a> Scanner<'a> {
     fn new(text: &'a str) -> Self {
-        Scanner {
-            text,
-            pos: 0,
-            line: 1,
-            col: 1,
-            depth: 0,
-        }
+        Scanner { text, pos: 0, line: 1, col: 1, depth: 0 }
     }
     fn peek(&self) -> Option<u8> {
         self.text.as_bytes().get(self.pos).copied()
@@ -256,10 +237,7 @@ impl<'a> Scanner<'a> {
     }
     fn number(&mut self) -> Scan<String> {
         let start = self.pos;
-        while matches!(
-            self.peek(),
-            Some(b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E')
-        ) {
+        while matches!(self.peek(), Some(b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E')) {
             self.next();
         }
         if self.pos == start {
@@ -312,12 +290,7 @@ impl<'a> Scanner<'a> {
             self.ws();
             self.eat(b':')?;
             let value = self.value()?;
-            members.push(Member {
-                key,
-                line,
-                col,
-                value,
-            });
+            members.push(Member { key, line, col, value });
             self.ws();
             match self.next() {
                 Some(b',') => {}
@@ -336,45 +309,24 @@ mod tests {
     fn json_positions_of_keys_and_array_items() {
         let text = "{\n  \"Scene\": {\n    \"Obj\": [\n      {\"_id\": \"1\", \"_data\": \"1 2 3\"},\n      \"x\"\n    ],\n    \"N\": 4.5e1\n  }\n}";
         let scene = parse(text, Path::new("s.json")).unwrap();
-        assert_eq!(
-            (scene.name.as_str(), scene.line, scene.col),
-            ("Scene", 2, 3)
-        );
-        let objs: Vec<_> = scene
-            .children
-            .iter()
-            .map(|c| (c.name.as_str(), c.line, c.col))
-            .collect();
+        assert_eq!((scene.name.as_str(), scene.line, scene.col), ("Scene", 2, 3));
+        let objs: Vec<_> = scene.children.iter().map(|c| (c.name.as_str(), c.line, c.col)).collect();
         assert_eq!(objs, [("Obj", 4, 7), ("Obj", 5, 7), ("N", 7, 5)]);
         assert_eq!(scene.children[0].text, "1 2 3");
         let id = &scene.children[0].attrs[0];
-        assert_eq!(
-            (id.name.as_str(), id.value.as_str(), id.line, id.col),
-            ("id", "1", 4, 8)
-        );
+        assert_eq!((id.name.as_str(), id.value.as_str(), id.line, id.col), ("id", "1", 4, 8));
         assert_eq!(scene.children[2].text, "4.5e1");
     }
 
     #[test]
     fn json_syntax_error_has_line_and_column() {
-        let e = parse(
-            "{\n  \"Scene\": {\n    \"A\": \"1\"\n    \"B\": 2\n  }\n}",
-            Path::new("bad.json"),
-        )
-        .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "bad.json:4:5: JSON syntax error: expected `,` or `}`"
-        );
+        let e = parse("{\n  \"Scene\": {\n    \"A\": \"1\"\n    \"B\": 2\n  }\n}", Path::new("bad.json")).unwrap_err();
+        assert_eq!(e.to_string(), "bad.json:4:5: JSON syntax error: expected `,` or `}`");
     }
 
     #[test]
     fn json_keeps_key_order_escapes_and_columns_after_unicode() {
-        let v = parse_value(
-            "{\"b\": \"\\u00e9\\n\", \"é\": 1, \"a\": null}",
-            Path::new("s.json"),
-        )
-        .unwrap();
+        let v = parse_value("{\"b\": \"\\u00e9\\n\", \"é\": 1, \"a\": null}", Path::new("s.json")).unwrap();
         let Value::Object(m) = v.value else { panic!() };
         let keys: Vec<_> = m.iter().map(|m| (m.key.as_str(), m.col)).collect();
         assert_eq!(keys, [("b", 2), ("é", 19), ("a", 27)]);
@@ -383,8 +335,7 @@ mod tests {
 
     #[test]
     fn json_top_level_keys_without_building() {
-        let keys =
-            top_level_keys(" {\"Camera\": {\"a\": [1, {\"b\": \"}\"}]}, \"Objects\": []}").unwrap();
+        let keys = top_level_keys(" {\"Camera\": {\"a\": [1, {\"b\": \"}\"}]}, \"Objects\": []}").unwrap();
         assert_eq!(keys, ["Camera", "Objects"]);
         assert_eq!(top_level_keys("[1]"), None);
         let deep = format!("{{\"a\": {}", "[".repeat(100_000));

@@ -23,10 +23,7 @@ use crate::{Error, Location, Result};
 /// Reads the scene below the root element `root` of the file `path`.
 pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
     if root.name != "Scene" {
-        return Err(Error::input(
-            root.loc(path),
-            format!("root element is <{}>, expected <Scene>", root.name),
-        ));
+        return Err(Error::input(root.loc(path), format!("root element is <{}>, expected <Scene>", root.name)));
     }
     root.mark_used();
     let mut r = Reader {
@@ -62,20 +59,12 @@ pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
     }
     for u in root.unused() {
         match u {
-            Unused::Element(n, parent) => r.notes.plain(
-                n.loc(path),
-                format!(
-                    "<{}> in <{parent}> ignored (unknown or unused here)",
-                    n.name
-                ),
-            ),
-            Unused::Attr(a, elem) => r.notes.plain(
-                a.loc(path),
-                format!(
-                    "attribute {} of <{elem}> ignored (unknown or unused here)",
-                    a.name
-                ),
-            ),
+            Unused::Element(n, parent) => {
+                r.notes.plain(n.loc(path), format!("<{}> in <{parent}> ignored (unknown or unused here)", n.name))
+            }
+            Unused::Attr(a, elem) => {
+                r.notes.plain(a.loc(path), format!("attribute {} of <{elem}> ignored (unknown or unused here)", a.name))
+            }
         }
     }
     r.desc.warnings = r.notes.finish();
@@ -127,24 +116,16 @@ struct Reader<'a> {
 fn vertex_data(v: &Node, path: &Path) -> Result<Vec<Vec3>> {
     if let Some(t) = v.attr("type") {
         if t.trimmed() != "xyz" {
-            let msg = format!(
-                "<VertexData>: unknown type '{}' (expected xyz)",
-                t.trimmed()
-            );
+            let msg = format!("<VertexData>: unknown type '{}' (expected xyz)", t.trimmed());
             return Err(Error::input(t.loc(path), msg));
         }
     }
     let f = v.floats(path)?;
     if f.len() % 3 != 0 {
-        let msg = format!(
-            "<VertexData>: expected x y z triples, found {} numbers",
-            f.len()
-        );
+        let msg = format!("<VertexData>: expected x y z triples, found {} numbers", f.len());
         return Err(Error::input(v.loc(path), msg));
     }
-    Ok(f.chunks_exact(3)
-        .map(|c| Vec3::new(c[0], c[1], c[2]))
-        .collect())
+    Ok(f.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
 }
 
 impl Reader<'_> {
@@ -172,8 +153,7 @@ impl Reader<'_> {
         for n in parent.all(name) {
             n.mark_subtree_used();
             let msg = format!("{what} not supported; ignored");
-            self.notes
-                .feature(n.loc(self.path), &format!("<{name}>"), &msg);
+            self.notes.feature(n.loc(self.path), &format!("<{name}>"), &msg);
         }
     }
 
@@ -215,9 +195,7 @@ impl Reader<'_> {
                 _ => continue,
             };
             n.mark_used();
-            let id = n
-                .attr("id")
-                .ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
+            let id = n.attr("id").ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
             let (made, degenerate) = match prefix {
                 "t" => (Some(Transform::translate(n.vec3(p)?)), ""),
                 "s" => (Transform::scale(n.vec3(p)?), "a scale factor is zero"),
@@ -250,12 +228,10 @@ impl Reader<'_> {
         };
         let mut acc = Transform::IDENTITY;
         for name in list.trimmed().split_whitespace() {
-            let t = self.transforms.get(name).ok_or_else(|| {
-                self.err(
-                    list,
-                    format!("<Transformations>: unknown transformation '{name}'"),
-                )
-            })?;
+            let t = self
+                .transforms
+                .get(name)
+                .ok_or_else(|| self.err(list, format!("<Transformations>: unknown transformation '{name}'")))?;
             // The first listed is applied first (README (ii), "Mesh/Transformations").
             acc = acc.then(t);
         }
@@ -308,8 +284,7 @@ impl Reader<'_> {
     fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
         let c = self.req(n, name)?;
         let v = c.vec3(self.path)?;
-        v.try_normalize()
-            .ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
+        v.try_normalize().ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
     }
 }
 
@@ -327,8 +302,7 @@ mod tests {
         read(&xml::parse(&format!("<Scene>{body}</Scene>"), path)?, path)
     }
 
-    const MATERIAL: &str =
-        "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+    const MATERIAL: &str = "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
         <DiffuseReflectance>1 1 1</DiffuseReflectance></Material></Materials>";
 
     #[test]
@@ -362,36 +336,23 @@ mod tests {
              <MotionBlur>0 0 1</MotionBlur></Sphere></Objects>"
         );
         let d = read_xml(&body).unwrap();
-        assert_eq!(
-            d.warnings,
-            ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]
-        );
+        assert_eq!(d.warnings, ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]);
     }
 
     #[test]
     fn metu_degenerate_transformations_are_errors() {
-        let e = read_xml("<Transformations><Scaling id=\"2\">1 0 1</Scaling></Transformations>")
-            .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "t.xml:1:25: <Scaling>: a scale factor is zero"
-        );
+        let e = read_xml("<Transformations><Scaling id=\"2\">1 0 1</Scaling></Transformations>").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:25: <Scaling>: a scale factor is zero");
         let c = "<Transformations><Composite id=\"1\">0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1</Composite></Transformations>";
         let e = read_xml(c).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "t.xml:1:25: <Composite>: the matrix is not invertible"
-        );
+        assert_eq!(e.to_string(), "t.xml:1:25: <Composite>: the matrix is not invertible");
     }
 
     #[test]
     fn metu_root_must_be_scene_and_types_must_be_known() {
         let path = Path::new("t.xml");
         let e = read(&xml::parse("<Scen/>", path).unwrap(), path).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "t.xml:1:1: root element is <Scen>, expected <Scene>"
-        );
+        assert_eq!(e.to_string(), "t.xml:1:1: root element is <Scen>, expected <Scene>");
         let body = MATERIAL.replace("id=\"1\"", "id=\"1\" type=\"glass\"");
         let e = read_xml(&body).unwrap_err();
         assert_eq!(

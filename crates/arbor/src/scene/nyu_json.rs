@@ -12,10 +12,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::json::{self, Member, Spanned, Value};
-use super::{
-    CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc,
-    ShapeDesc, Window,
-};
+use super::{CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, ShapeDesc, Window};
 use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
 use crate::{Error, Location, Result};
@@ -26,10 +23,7 @@ const HEIGHT: u32 = 480;
 /// True when `text` has the NYU layout: top-level `Camera` or `Objects` keys (a METU JSON scene has
 /// everything inside a top-level `Scene`). Scans the top-level keys only; never fails.
 pub fn looks_like_nyu(text: &str) -> bool {
-    json::top_level_keys(text).is_some_and(|keys| {
-        keys.iter()
-            .any(|k| matches!(k.as_str(), "Camera" | "Objects"))
-    })
+    json::top_level_keys(text).is_some_and(|keys| keys.iter().any(|k| matches!(k.as_str(), "Camera" | "Objects")))
 }
 
 /// Reads an NYU `scene.json`.
@@ -48,33 +42,22 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
         scene.unknown(&["Background", "Ambient"], &mut warn);
     }
     let cam = top.required("Camera")?;
-    desc.cameras.push(camera(
-        &Obj::new(&cam.value, "Camera", path)?,
-        cam,
-        &mut warn,
-    )?);
+    desc.cameras.push(camera(&Obj::new(&cam.value, "Camera", path)?, cam, &mut warn)?);
     for (i, m) in top.array("Materials")?.iter().enumerate() {
-        desc.materials
-            .push(material(&Obj::new(m, "a material", path)?, i, &mut warn)?);
+        desc.materials.push(material(&Obj::new(m, "a material", path)?, i, &mut warn)?);
     }
     for l in top.array("Lights")? {
         let l = Obj::new(l, "a light", path)?;
         let position = l.vec3("Position")?;
         let intensity = l.vec3("Color")?;
         l.unknown(&["Position", "Color"], &mut warn);
-        desc.lights.push(LightDesc::Point {
-            position,
-            intensity,
-        });
+        desc.lights.push(LightDesc::Point { position, intensity });
     }
     for (i, o) in top.array("Objects")?.iter().enumerate() {
         let obj = object(&Obj::new(o, "an object", path)?, i, &desc, &mut warn)?;
         desc.objects.push(obj);
     }
-    top.unknown(
-        &["Scene", "Camera", "Materials", "Lights", "Objects"],
-        &mut warn,
-    );
+    top.unknown(&["Scene", "Camera", "Materials", "Lights", "Objects"], &mut warn);
     desc.warnings = warn;
     Ok(desc)
 }
@@ -95,31 +78,14 @@ fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc
         let msg = "depth of field not supported (the reference images show none); lens ignored";
         warn.push(format!("{}: \"LensRadius\": {msg}", c.loc(m)));
     }
-    c.unknown(
-        &[
-            "IsPerspective",
-            "Position",
-            "FieldOfView",
-            "FocalLength",
-            "LensRadius",
-        ],
-        warn,
-    );
-    let stem = c
-        .path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy());
+    c.unknown(&["IsPerspective", "Position", "FieldOfView", "FocalLength", "LensRadius"], warn);
+    let stem = c.path.file_stem().map_or("scene".into(), |s| s.to_string_lossy());
     Ok(CameraDesc {
         id: "Camera".into(),
         position: c.vec3("Position")?,
         gaze: Vec3::NEG_Z,
         up: Vec3::Y,
-        window: Window {
-            left: -right,
-            right,
-            bottom: -top,
-            top,
-        },
+        window: Window { left: -right, right, bottom: -top, top },
         near_distance: focal,
         orthographic,
         width: WIDTH,
@@ -137,27 +103,13 @@ fn material(m: &Obj<'_>, i: usize, warn: &mut Vec<String>) -> Result<MaterialDes
     let mirror = zero_if_absent("Mirror")?;
     let refraction = zero_if_absent("Refraction")?;
     let kind = if refraction != Color::ZERO {
-        MaterialKind::Transparent {
-            eta: m.number("RefractionIndex")?,
-            transparency: refraction,
-            mirror,
-        }
+        MaterialKind::Transparent { eta: m.number("RefractionIndex")?, transparency: refraction, mirror }
     } else if mirror != Color::ZERO {
-        MaterialKind::Mirror {
-            reflectance: mirror,
-        }
+        MaterialKind::Mirror { reflectance: mirror }
     } else {
         MaterialKind::BlinnPhong
     };
-    let known = [
-        "Ambient",
-        "Diffuse",
-        "Specular",
-        "Shininess",
-        "Mirror",
-        "Refraction",
-        "RefractionIndex",
-    ];
+    let known = ["Ambient", "Diffuse", "Specular", "Shininess", "Mirror", "Refraction", "RefractionIndex"];
     m.unknown(&known, warn);
     Ok(MaterialDesc {
         id: i.to_string(),
@@ -177,21 +129,12 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
     let name = format!("{kind} {i}");
     let mat = o.required("Material")?;
     let material = match &mat.value.value {
-        Value::Number(n) => n
-            .parse::<usize>()
-            .ok()
-            .filter(|&m| m < desc.materials.len()),
+        Value::Number(n) => n.parse::<usize>().ok().filter(|&m| m < desc.materials.len()),
         _ => None,
     }
     .ok_or_else(|| {
         let n = desc.materials.len();
-        o.bad(
-            mat,
-            &format!(
-                "{name}: no material {} (the scene has {n}, numbered from 0)",
-                text_of(mat)
-            ),
-        )
+        o.bad(mat, &format!("{name}: no material {} (the scene has {n}, numbered from 0)", text_of(mat)))
     })?;
     let (shape, known): (ShapeDesc, &[&str]) = match kind.as_str() {
         "Mesh" => {
@@ -201,13 +144,7 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
             };
             let dir = o.path.parent().unwrap_or(Path::new(""));
             let source = MeshSource::File(dir.join(file));
-            (
-                ShapeDesc::Mesh {
-                    source,
-                    smooth: false,
-                },
-                &["Path"],
-            )
+            (ShapeDesc::Mesh { source, smooth: false }, &["Path"])
         }
         "Sphere" => {
             let radius = o.number("Radius")?;
@@ -215,13 +152,7 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
                 let r = o.required("Radius")?;
                 return Err(o.bad(r, &format!("{name}: negative radius {radius}")));
             }
-            (
-                ShapeDesc::Sphere {
-                    center: o.vec3("Position")?,
-                    radius,
-                },
-                &["Position", "Radius"],
-            )
+            (ShapeDesc::Sphere { center: o.vec3("Position")?, radius }, &["Position", "Radius"])
         }
         "Parallelogram" => {
             let origin = o.vec3("Origin")?;
@@ -233,30 +164,17 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
                 ..Default::default()
             };
             let source = MeshSource::Inline(Arc::new(mesh));
-            (
-                ShapeDesc::Mesh {
-                    source,
-                    smooth: false,
-                },
-                &["Origin", "u", "v", "U", "V"],
-            )
+            (ShapeDesc::Mesh { source, smooth: false }, &["Origin", "u", "v", "U", "V"])
         }
         other => {
-            let msg =
-                format!("unknown object type '{other}' (expected Mesh, Sphere or Parallelogram)");
+            let msg = format!("unknown object type '{other}' (expected Mesh, Sphere or Parallelogram)");
             return Err(o.bad(ty, &msg));
         }
     };
     let mut all = vec!["Type", "Material"];
     all.extend_from_slice(known);
     o.unknown(&all, warn);
-    Ok(ObjectDesc {
-        name,
-        material,
-        shape,
-        transform: Transform::IDENTITY,
-        loc: o.loc(ty),
-    })
+    Ok(ObjectDesc { name, material, shape, transform: Transform::IDENTITY, loc: o.loc(ty) })
 }
 
 fn text_of(m: &Member) -> String {
@@ -278,16 +196,8 @@ struct Obj<'a> {
 impl<'a> Obj<'a> {
     fn new(v: &'a Spanned, what: &'a str, path: &'a Path) -> Result<Self> {
         match &v.value {
-            Value::Object(members) => Ok(Obj {
-                members,
-                at: v,
-                what,
-                path,
-            }),
-            _ => Err(Error::input(
-                Location::at(path, v.line, v.col),
-                format!("{what}: expected a JSON object"),
-            )),
+            Value::Object(members) => Ok(Obj { members, at: v, what, path }),
+            _ => Err(Error::input(Location::at(path, v.line, v.col), format!("{what}: expected a JSON object"))),
         }
     }
     fn loc(&self, m: &Member) -> Location {
@@ -333,17 +243,8 @@ impl<'a> Obj<'a> {
     }
     /// Warns about every key not in `known`.
     fn unknown(&self, known: &[&str], warn: &mut Vec<String>) {
-        for m in self
-            .members
-            .iter()
-            .filter(|m| !known.contains(&m.key.as_str()))
-        {
-            let w = format!(
-                "{}: \"{}\" in {} ignored (unknown)",
-                self.loc(m),
-                m.key,
-                self.what
-            );
+        for m in self.members.iter().filter(|m| !known.contains(&m.key.as_str())) {
+            let w = format!("{}: \"{}\" in {} ignored (unknown)", self.loc(m), m.key, self.what);
             warn.push(w);
         }
     }
@@ -362,9 +263,7 @@ mod tests {
 
     #[test]
     fn nyu_looks_like_nyu_tells_the_forms_apart() {
-        assert!(looks_like_nyu(
-            "{\"Scene\": {\"Background\": [0, 0, 0]}, \"Camera\": {}}"
-        ));
+        assert!(looks_like_nyu("{\"Scene\": {\"Background\": [0, 0, 0]}, \"Camera\": {}}"));
         assert!(looks_like_nyu("{\"Objects\": []}"));
         let metu = "{\"Scene\": {\"Cameras\": {\"Camera\": {}}, \"Objects\": {}}}";
         assert!(!looks_like_nyu(metu));
@@ -378,33 +277,18 @@ mod tests {
                     \"FieldOfView\": 1.5707964, \"FocalLength\": 2.0, \"LensRadius\": 0.1}}";
         let d = parse(text, Path::new("data/scene.json")).unwrap();
         let c = &d.cameras[0];
-        assert_eq!(
-            (c.gaze, c.up, c.orthographic),
-            (Vec3::NEG_Z, Vec3::Y, false)
-        );
+        assert_eq!((c.gaze, c.up, c.orthographic), (Vec3::NEG_Z, Vec3::Y, false));
         // 90° vertical at focal length 2: top = 2; 640x480 makes right 8/3.
         assert!((c.window.top - 2.0).abs() < 1e-5 && (c.window.right - 8.0 / 3.0).abs() < 1e-5);
-        assert_eq!(
-            (c.image_name.as_str(), c.near_distance, c.lens),
-            ("scene.png", 2.0, None)
-        );
-        assert_eq!(
-            d.warnings.len(),
-            1,
-            "the lens is reported: {:?}",
-            d.warnings
-        );
+        assert_eq!((c.image_name.as_str(), c.near_distance, c.lens), ("scene.png", 2.0, None));
+        assert_eq!(d.warnings.len(), 1, "the lens is reported: {:?}", d.warnings);
     }
 
     #[test]
     fn nyu_errors_name_the_key_and_its_line() {
-        let text =
-            "{\n  \"Camera\": {\"Position\": [0, 0], \"FieldOfView\": 1, \"FocalLength\": 1}\n}";
+        let text = "{\n  \"Camera\": {\"Position\": [0, 0], \"FieldOfView\": 1, \"FocalLength\": 1}\n}";
         let e = parse(text, Path::new("s.json")).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "s.json:2:14: \"Position\": expected an array of 3 numbers"
-        );
+        assert_eq!(e.to_string(), "s.json:2:14: \"Position\": expected an array of 3 numbers");
         let e = parse("{\"Objects\": []}", Path::new("s.json")).unwrap_err();
         assert_eq!(e.to_string(), "s.json:1:1: the scene: missing \"Camera\"");
     }

@@ -58,13 +58,7 @@ pub enum Unused<'a> {
 impl Attr {
     /// A new attribute at `line:col`.
     pub fn new(name: impl Into<String>, value: impl Into<String>, line: u32, col: u32) -> Self {
-        Attr {
-            name: name.into(),
-            value: value.into(),
-            line,
-            col,
-            used: Cell::new(false),
-        }
+        Attr { name: name.into(), value: value.into(), line, col, used: Cell::new(false) }
     }
     /// Where the attribute is.
     pub fn loc(&self, path: &Path) -> Location {
@@ -77,14 +71,7 @@ impl Attr {
     /// The value as an integer.
     pub fn int(&self, path: &Path) -> Result<i64> {
         self.trimmed().parse().map_err(|_| {
-            Error::input(
-                self.loc(path),
-                format!(
-                    "attribute {}: malformed integer '{}'",
-                    self.name,
-                    self.trimmed()
-                ),
-            )
+            Error::input(self.loc(path), format!("attribute {}: malformed integer '{}'", self.name, self.trimmed()))
         })
     }
     /// The value as `true` or `false`.
@@ -92,11 +79,7 @@ impl Attr {
         parse_bool(self.trimmed()).ok_or_else(|| {
             Error::input(
                 self.loc(path),
-                format!(
-                    "attribute {}: expected true or false, found '{}'",
-                    self.name,
-                    self.trimmed()
-                ),
+                format!("attribute {}: expected true or false, found '{}'", self.name, self.trimmed()),
             )
         })
     }
@@ -143,10 +126,7 @@ impl Node {
     }
     /// The children called `name`, in file order; all of them count as read.
     pub fn all<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
-        self.children
-            .iter()
-            .filter(move |c| c.name == name)
-            .inspect(|c| c.mark_used())
+        self.children.iter().filter(move |c| c.name == name).inspect(|c| c.mark_used())
     }
     /// The last child called `name` (the last one wins, as in the official parsers), with every child of
     /// that name counted as read. Duplicates are the caller's to report ([`Node::duplicates`]).
@@ -160,9 +140,7 @@ impl Node {
     }
     /// The child called `name`, or an error naming this element and the missing one.
     pub fn required(&self, name: &str, path: &Path) -> Result<&Node> {
-        self.child(name).ok_or_else(|| {
-            Error::input(self.loc(path), format!("<{}>: missing <{name}>", self.name))
-        })
+        self.child(name).ok_or_else(|| Error::input(self.loc(path), format!("<{}>: missing <{name}>", self.name)))
     }
     /// Children called `name` beyond the first, for a "duplicate, the last one wins" warning.
     pub fn duplicates<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
@@ -210,36 +188,22 @@ impl Node {
     pub fn ints(&self, path: &Path) -> Result<Vec<i64>> {
         self.trimmed()
             .split_whitespace()
-            .map(|tok| {
-                tok.parse()
-                    .map_err(|_| self.malformed("integer", tok, path))
-            })
+            .map(|tok| tok.parse().map_err(|_| self.malformed("integer", tok, path)))
             .collect()
     }
     /// One non-negative integer.
     pub fn uint(&self, path: &Path) -> Result<u32> {
         let tok = self.trimmed();
-        tok.parse()
-            .map_err(|_| self.malformed("integer", tok, path))
+        tok.parse().map_err(|_| self.malformed("integer", tok, path))
     }
     /// `true` or `false`.
     pub fn boolean(&self, path: &Path) -> Result<bool> {
         parse_bool(self.trimmed()).ok_or_else(|| {
-            Error::input(
-                self.loc(path),
-                format!(
-                    "<{}>: expected true or false, found '{}'",
-                    self.name,
-                    self.trimmed()
-                ),
-            )
+            Error::input(self.loc(path), format!("<{}>: expected true or false, found '{}'", self.name, self.trimmed()))
         })
     }
     fn malformed(&self, what: &str, tok: &str, path: &Path) -> Error {
-        Error::input(
-            self.loc(path),
-            format!("<{}>: malformed {what} '{tok}'", self.name),
-        )
+        Error::input(self.loc(path), format!("<{}>: malformed {what} '{tok}'", self.name))
     }
     /// Everything below this element that was never read, outermost first: an ignored element is
     /// reported once, not with each of its descendants.
@@ -282,26 +246,15 @@ mod tests {
     #[test]
     fn tree_floats_trims_padding() {
         let n = node("Position", "\n  0 -1.5\t 2e1  ");
-        assert_eq!(
-            n.vec3(Path::new("s.xml")).unwrap(),
-            Vec3::new(0.0, -1.5, 20.0)
-        );
+        assert_eq!(n.vec3(Path::new("s.xml")).unwrap(), Vec3::new(0.0, -1.5, 20.0));
     }
 
     #[test]
     fn tree_malformed_number_names_element_and_text() {
-        let e = node("Radius", " abc ")
-            .float(Path::new("scene.xml"))
-            .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "scene.xml:12:13: <Radius>: malformed number 'abc'"
-        );
+        let e = node("Radius", " abc ").float(Path::new("scene.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "scene.xml:12:13: <Radius>: malformed number 'abc'");
         let e = node("Radius", "nan").float(Path::new("s.xml")).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "s.xml:12:13: <Radius>: malformed number 'nan'"
-        );
+        assert_eq!(e.to_string(), "s.xml:12:13: <Radius>: malformed number 'nan'");
     }
 
     #[test]
@@ -310,10 +263,7 @@ mod tests {
         let n = node("NearPlane", "-1 1 -1 1 10");
         assert_eq!(n.floats_n(4, true, p).unwrap(), vec![-1.0, 1.0, -1.0, 1.0]);
         let e = n.floats_n(4, false, p).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "s.xml:12:13: <NearPlane>: expected 4 numbers, found 5"
-        );
+        assert_eq!(e.to_string(), "s.xml:12:13: <NearPlane>: expected 4 numbers, found 5");
     }
 
     #[test]

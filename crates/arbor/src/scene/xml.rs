@@ -11,21 +11,13 @@ use crate::{Error, Location, Result};
 
 /// Parses `text` (the content of `path`) into the tree of its root element.
 pub fn parse(text: &str, path: &Path) -> Result<Node> {
-    let opts = roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
+    let opts = roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() };
     let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
         let pos = e.pos();
         let msg = e.to_string();
         // roxmltree appends the position to its message; the location already says it.
-        let msg = msg
-            .strip_suffix(&format!(" at {}:{}", pos.row, pos.col))
-            .unwrap_or(&msg);
-        Error::input(
-            Location::at(path, pos.row, pos.col),
-            format!("XML syntax error: {msg}"),
-        )
+        let msg = msg.strip_suffix(&format!(" at {}:{}", pos.row, pos.col)).unwrap_or(&msg);
+        Error::input(Location::at(path, pos.row, pos.col), format!("XML syntax error: {msg}"))
     })?;
     let lines = LineIndex::new(text);
     convert(doc.root_element(), &lines, 0, path)
@@ -35,12 +27,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Node> {
 /// without bound (serde_json applies a similar limit, 128, to JSON).
 const MAX_DEPTH: usize = 128;
 
-fn convert(
-    e: roxmltree::Node<'_, '_>,
-    lines: &LineIndex<'_>,
-    depth: usize,
-    path: &Path,
-) -> Result<Node> {
+fn convert(e: roxmltree::Node<'_, '_>, lines: &LineIndex<'_>, depth: usize, path: &Path) -> Result<Node> {
     let (line, col) = lines.pos(e.range().start);
     if depth > MAX_DEPTH {
         let msg = format!("elements nested more than {MAX_DEPTH} deep");
@@ -71,9 +58,7 @@ struct LineIndex<'a> {
 
 impl<'a> LineIndex<'a> {
     fn new(text: &'a str) -> Self {
-        let starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
+        let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
         LineIndex { text, starts }
     }
     fn pos(&self, byte: usize) -> (u32, u32) {
@@ -90,8 +75,7 @@ mod tests {
 
     #[test]
     fn xml_positions_of_elements_and_attributes() {
-        let text =
-            "<Scene>\n  <Camera id=\"1\">\n    <Position> 0 0 1 </Position>\n  </Camera>\n</Scene>";
+        let text = "<Scene>\n  <Camera id=\"1\">\n    <Position> 0 0 1 </Position>\n  </Camera>\n</Scene>";
         let root = parse(text, Path::new("s.xml")).unwrap();
         assert_eq!((root.name.as_str(), root.line, root.col), ("Scene", 1, 1));
         let cam = &root.children[0];
@@ -113,10 +97,7 @@ mod tests {
     fn xml_deep_nesting_is_an_error_not_a_stack_overflow() {
         let text = format!("{}{}", "<a>".repeat(1000), "</a>".repeat(1000));
         let e = parse(&text, Path::new("deep.xml")).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "deep.xml:1:388: elements nested more than 128 deep"
-        );
+        assert_eq!(e.to_string(), "deep.xml:1:388: elements nested more than 128 deep");
     }
 
     #[test]

@@ -36,16 +36,8 @@ struct BuildPrim {
 
 /// The temporary tree.
 enum BuildNode {
-    Leaf {
-        bounds: Aabb,
-        first: u32,
-        count: u16,
-    },
-    Inner {
-        bounds: Aabb,
-        axis: u8,
-        children: Box<[BuildNode; 2]>,
-    },
+    Leaf { bounds: Aabb, first: u32, count: u16 },
+    Inner { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
 }
 
 /// How to split a node.
@@ -77,18 +69,10 @@ impl Binner {
 }
 
 /// Builds the flat node array, the reordered primitive indices and the number of primitives in the tree.
-pub(super) fn build_sah<P: Primitives + ?Sized>(
-    prims: &P,
-    params: &BvhParams,
-) -> (Vec<Node>, Vec<u32>, usize) {
-    assert!(
-        prims.len() <= u32::MAX as usize,
-        "a BVH indexes at most 2^32 - 1 primitives"
-    );
-    let all: Vec<(u32, Option<BuildPrim>)> = (0..prims.len())
-        .into_par_iter()
-        .map(|i| (i as u32, build_prim(prims, i)))
-        .collect();
+pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> (Vec<Node>, Vec<u32>, usize) {
+    assert!(prims.len() <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
+    let all: Vec<(u32, Option<BuildPrim>)> =
+        (0..prims.len()).into_par_iter().map(|i| (i as u32, build_prim(prims, i))).collect();
     let mut live: Vec<BuildPrim> = all.iter().filter_map(|(_, p)| *p).collect();
     let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i);
     let mut nodes = Vec::new();
@@ -111,25 +95,12 @@ fn build_prim<P: Primitives + ?Sized>(prims: &P, i: usize) -> Option<BuildPrim> 
     }
     let c = prims.centroid(i);
     // Halves before adding: the plain midpoint overflows for boxes near the float range.
-    let centroid = if c.is_finite() {
-        c
-    } else {
-        0.5 * bounds.min + 0.5 * bounds.max
-    };
-    Some(BuildPrim {
-        bounds,
-        centroid,
-        index: i as u32,
-    })
+    let centroid = if c.is_finite() { c } else { 0.5 * bounds.min + 0.5 * bounds.max };
+    Some(BuildPrim { bounds, centroid, index: i as u32 })
 }
 
 /// Builds the subtree over `prims`, which sit at `offset` in the final index array.
-fn build_node(
-    prims: &mut [BuildPrim],
-    offset: usize,
-    depth: usize,
-    params: &BvhParams,
-) -> BuildNode {
+fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams) -> BuildNode {
     let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
     let Some(split) = find_split(prims, &bounds, depth, params) else {
         return make_leaf(bounds, offset, prims.len());
@@ -142,35 +113,19 @@ fn build_node(
             || build_node(right, offset + mid, depth + 1, params),
         )
     } else {
-        (
-            build_node(left, offset, depth + 1, params),
-            build_node(right, offset + mid, depth + 1, params),
-        )
+        (build_node(left, offset, depth + 1, params), build_node(right, offset + mid, depth + 1, params))
     };
-    BuildNode::Inner {
-        bounds,
-        axis: axis as u8,
-        children: Box::new([l, r]),
-    }
+    BuildNode::Inner { bounds, axis: axis as u8, children: Box::new([l, r]) }
 }
 
 /// A leaf over `count` primitives at `offset`.
 fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode {
     debug_assert!((1..=LEAF_HARD_MAX).contains(&count));
-    BuildNode::Leaf {
-        bounds,
-        first: offset as u32,
-        count: count as u16,
-    }
+    BuildNode::Leaf { bounds, first: offset as u32, count: count as u16 }
 }
 
 /// The split to make, or `None` for a leaf.
-fn find_split(
-    prims: &[BuildPrim],
-    bounds: &Aabb,
-    depth: usize,
-    params: &BvhParams,
-) -> Option<Split> {
+fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhParams) -> Option<Split> {
     let n = prims.len();
     if n == 1 {
         return None;
@@ -204,12 +159,7 @@ fn find_split(
 }
 
 /// The cheapest plane (after bin `k`, `k < bins - 1`) and its SAH cost.
-fn best_bin(
-    prims: &[BuildPrim],
-    bounds: &Aabb,
-    binner: &Binner,
-    params: &BvhParams,
-) -> (usize, f64) {
+fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhParams) -> (usize, f64) {
     let nb = binner.bins;
     let mut counts = [0usize; super::MAX_BINS];
     let mut boxes = [Aabb::EMPTY; super::MAX_BINS];
@@ -239,9 +189,7 @@ fn best_bin(
             continue;
         }
         let cost = params.traversal_cost as f64
-            + params.intersection_cost as f64
-                * (c as f64 * area_f64(&b) + right_cost[k])
-                * inv_area;
+            + params.intersection_cost as f64 * (c as f64 * area_f64(&b) + right_cost[k]) * inv_area;
         if cost < best.1 {
             best = (k, cost);
         }
@@ -272,9 +220,7 @@ fn partition(prims: &mut [BuildPrim], split: Split) -> (usize, usize) {
 fn count_nodes(node: &BuildNode) -> usize {
     match node {
         BuildNode::Leaf { .. } => 1,
-        BuildNode::Inner { children, .. } => {
-            1 + count_nodes(&children[0]) + count_nodes(&children[1])
-        }
+        BuildNode::Inner { children, .. } => 1 + count_nodes(&children[0]) + count_nodes(&children[1]),
     }
 }
 
@@ -282,16 +228,8 @@ fn count_nodes(node: &BuildNode) -> usize {
 fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
     let index = out.len();
     match node {
-        BuildNode::Leaf {
-            bounds,
-            first,
-            count,
-        } => out.push(Node::leaf(*bounds, *first, *count)),
-        BuildNode::Inner {
-            bounds,
-            axis,
-            children,
-        } => {
+        BuildNode::Leaf { bounds, first, count } => out.push(Node::leaf(*bounds, *first, *count)),
+        BuildNode::Inner { bounds, axis, children } => {
             out.push(Node::inner(*bounds, 0, *axis));
             flatten(&children[0], out);
             let second = flatten(&children[1], out);

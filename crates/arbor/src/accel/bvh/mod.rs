@@ -69,25 +69,11 @@ impl Node {
     /// A leaf over `count` primitives starting at `first` in the index array.
     pub fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
         debug_assert!(count > 0);
-        Node {
-            min: bounds.min.to_array(),
-            max: bounds.max.to_array(),
-            offset: first,
-            count,
-            axis: 0,
-            pad: 0,
-        }
+        Node { min: bounds.min.to_array(), max: bounds.max.to_array(), offset: first, count, axis: 0, pad: 0 }
     }
     /// An inner node split on `axis` whose second child is node `second`.
     pub fn inner(bounds: Aabb, second: u32, axis: u8) -> Self {
-        Node {
-            min: bounds.min.to_array(),
-            max: bounds.max.to_array(),
-            offset: second,
-            count: 0,
-            axis,
-            pad: 0,
-        }
+        Node { min: bounds.min.to_array(), max: bounds.max.to_array(), offset: second, count: 0, axis, pad: 0 }
     }
     /// The node's box.
     #[inline]
@@ -118,31 +104,18 @@ pub struct BvhParams {
 impl Default for BvhParams {
     /// 16 bins, leaves of up to 8, and pbrt-v4's cost ratio (a node visit costs half a primitive test).
     fn default() -> Self {
-        BvhParams {
-            max_leaf_prims: 8,
-            bins: 16,
-            traversal_cost: 0.5,
-            intersection_cost: 1.0,
-        }
+        BvhParams { max_leaf_prims: 8, bins: 16, traversal_cost: 0.5, intersection_cost: 1.0 }
     }
 }
 
 impl BvhParams {
     /// Fewer bins and larger leaves: a quicker build for scenes rendered with few rays.
     pub fn fast_build() -> Self {
-        BvhParams {
-            max_leaf_prims: 16,
-            bins: 12,
-            ..Self::default()
-        }
+        BvhParams { max_leaf_prims: 16, bins: 12, ..Self::default() }
     }
     /// More bins and smaller leaves: a slower build for scenes rendered with many rays.
     pub fn quality() -> Self {
-        BvhParams {
-            max_leaf_prims: 4,
-            bins: 32,
-            ..Self::default()
-        }
+        BvhParams { max_leaf_prims: 4, bins: 32, ..Self::default() }
     }
     /// The parameters with every field in its valid range (NaN or negative costs become the defaults).
     fn sanitized(&self) -> Self {
@@ -183,12 +156,7 @@ impl Bvh {
         kind: &'static str,
         start: Instant,
     ) -> Bvh {
-        let mut bvh = Bvh {
-            nodes,
-            prim_indices,
-            live,
-            stats: AccelStats::default(),
-        };
+        let mut bvh = Bvh { nodes, prim_indices, live, stats: AccelStats::default() };
         bvh.stats = bvh.compute_stats(kind, start.elapsed());
         bvh
     }

@@ -36,18 +36,13 @@ fn soup(n: usize, seed: u64) -> TriangleMesh {
 
 fn rays(n: usize, seed: u64) -> Vec<Ray> {
     let mut rng = Rng(seed);
-    (0..n)
-        .map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5))
-        .collect()
+    (0..n).map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5)).collect()
 }
 
 fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
     let brute = BruteForce::build(mesh);
     for ray in rays {
-        let (a, b) = (
-            bvh.intersect(mesh, ray, f32::INFINITY),
-            brute.intersect(mesh, ray, f32::INFINITY),
-        );
+        let (a, b) = (bvh.intersect(mesh, ray, f32::INFINITY), brute.intersect(mesh, ray, f32::INFINITY));
         assert_eq!(a, b, "ray {ray:?}");
         assert_eq!(bvh.occluded(mesh, ray, 5.0), brute.occluded(mesh, ray, 5.0));
     }
@@ -74,24 +69,14 @@ fn bvh_single_primitive_is_one_leaf() {
     assert!(bvh.nodes()[0].is_leaf());
     let [a, b, c] = mesh.triangle(0);
     let target = (a + b + c) / 3.0;
-    let ray = Ray::new(
-        target + Vec3::new(0.0, 0.0, 20.0),
-        Vec3::new(0.0, 0.0, -1.0),
-    );
+    let ray = Ray::new(target + Vec3::new(0.0, 0.0, 20.0), Vec3::new(0.0, 0.0, -1.0));
     let ray = Ray::new(ray.origin, target - ray.origin);
-    assert_eq!(
-        bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim),
-        Some(0)
-    );
+    assert_eq!(bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim), Some(0));
 }
 
 #[test]
 fn bvh_matches_brute_force_on_small_soup() {
-    for (n, params) in [
-        (200, BvhParams::default()),
-        (300, BvhParams::fast_build()),
-        (500, BvhParams::quality()),
-    ] {
+    for (n, params) in [(200, BvhParams::default()), (300, BvhParams::fast_build()), (500, BvhParams::quality())] {
         let mesh = soup(n, n as u64);
         let bvh = Bvh::build_sah(&mesh, &params);
         bvh.validate(&mesh).unwrap();
@@ -105,17 +90,11 @@ fn bvh_duplicates_at_one_point_keep_leaves_bounded() {
     mesh.indices = vec![[0, 1, 2]; 1000];
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
     bvh.validate(&mesh).unwrap();
-    assert!(bvh
-        .nodes()
-        .iter()
-        .all(|n| (n.count as usize) <= LEAF_HARD_MAX));
+    assert!(bvh.nodes().iter().all(|n| (n.count as usize) <= LEAF_HARD_MAX));
     // Every copy is hit at the same t; the lowest index wins.
     let [a, b, c] = mesh.triangle(0);
     let ray = Ray::new(Vec3::splat(-5.0), (a + b + c) / 3.0 - Vec3::splat(-5.0));
-    assert_eq!(
-        bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim),
-        Some(0)
-    );
+    assert_eq!(bvh.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim), Some(0));
 }
 
 #[test]
@@ -128,17 +107,10 @@ fn bvh_ties_between_leaves_go_to_the_lowest_index() {
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
     assert_matches_brute(&mesh, &bvh, &rays(3000, 5));
     let [a, b, c] = mesh.triangle(0);
-    for o in [
-        Vec3::splat(-3.0),
-        Vec3::splat(13.0),
-        Vec3::new(13.0, -3.0, 5.0),
-    ] {
+    for o in [Vec3::splat(-3.0), Vec3::splat(13.0), Vec3::new(13.0, -3.0, 5.0)] {
         let ray = Ray::new(o, (a + b + c) / 3.0 - o);
         let hit = bvh.intersect(&mesh, &ray, f32::INFINITY);
-        assert_eq!(
-            hit,
-            BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY)
-        );
+        assert_eq!(hit, BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY));
     }
 }
 
@@ -148,8 +120,7 @@ fn bvh_non_finite_primitives_stay_out_of_the_tree() {
     let nan = mesh.positions.len() as u32;
     mesh.positions.push(Vec3::new(f32::NAN, 0.0, 0.0));
     mesh.positions.push(Vec3::new(f32::INFINITY, 1.0, 1.0));
-    mesh.positions
-        .push(Vec3::new(f32::NEG_INFINITY, f32::NAN, 1.0));
+    mesh.positions.push(Vec3::new(f32::NEG_INFINITY, f32::NAN, 1.0));
     mesh.indices.push([nan, nan + 1, nan + 2]);
     mesh.indices.push([nan + 1, nan + 2, 0]);
     mesh.indices.push([0, nan + 1, 1]);
@@ -183,11 +154,7 @@ fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
     for i in 0..2000 {
         let x = 0.93f32.powi(i);
         let k = mesh.positions.len() as u32;
-        mesh.positions.extend([
-            Vec3::new(x, 0.0, 0.0),
-            Vec3::new(x, 1.0, 0.0),
-            Vec3::new(x, 0.0, 1.0),
-        ]);
+        mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
         mesh.indices.push([k, k + 1, k + 2]);
     }
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
@@ -196,10 +163,7 @@ fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
     assert!(stats.max_depth < MAX_DEPTH, "{stats:?}");
     let ray = Ray::new(Vec3::new(2.0, 0.2, 0.2), -Vec3::X);
     let hit = bvh.intersect(&mesh, &ray, f32::INFINITY);
-    assert_eq!(
-        hit,
-        BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY)
-    );
+    assert_eq!(hit, BruteForce::build(&mesh).intersect(&mesh, &ray, f32::INFINITY));
 }
 
 #[test]
@@ -243,26 +207,15 @@ fn bvh_stats_describe_the_tree() {
     assert_eq!(s.kind, "bvh-sah");
     assert_eq!(s.primitives, 10_000);
     assert_eq!(s.nodes, 2 * s.leaves - 1);
-    assert!(
-        s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0,
-        "{s:?}"
-    );
+    assert!(s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0, "{s:?}");
     assert!(s.sah_cost > 1.0 && s.sah_cost < 10_000.0, "{s:?}");
-    assert_eq!(
-        s.bytes,
-        std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000
-    );
+    assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000);
 }
 
 #[test]
 fn bvh_params_are_clamped() {
     let mesh = soup(1000, 10);
-    let wild = BvhParams {
-        max_leaf_prims: 100_000,
-        bins: 0,
-        traversal_cost: f32::NAN,
-        intersection_cost: -1.0,
-    };
+    let wild = BvhParams { max_leaf_prims: 100_000, bins: 0, traversal_cost: f32::NAN, intersection_cost: -1.0 };
     let bvh = Bvh::build_sah(&mesh, &wild);
     bvh.validate(&mesh).unwrap();
     assert_matches_brute(&mesh, &bvh, &rays(500, 1));

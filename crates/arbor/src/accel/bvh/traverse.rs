@@ -45,11 +45,7 @@ impl RayBoxTest {
         RayBoxTest {
             origin: ray.origin.to_array(),
             inv_dir: inv.to_array(),
-            negative: [
-                inv.x.is_sign_negative(),
-                inv.y.is_sign_negative(),
-                inv.z.is_sign_negative(),
-            ],
+            negative: [inv.x.is_sign_negative(), inv.y.is_sign_negative(), inv.z.is_sign_negative()],
             major: if d.x > d.y && d.x > d.z {
                 0
             } else if d.y > d.z {
@@ -67,11 +63,7 @@ impl RayBoxTest {
         let mut far = t_far;
         let mut scale = 0.0f32;
         for a in 0..3 {
-            let (enter, exit) = if self.negative[a] {
-                (node.max[a], node.min[a])
-            } else {
-                (node.min[a], node.max[a])
-            };
+            let (enter, exit) = if self.negative[a] { (node.max[a], node.min[a]) } else { (node.min[a], node.max[a]) };
             let t0 = (enter - self.origin[a]) * self.inv_dir[a];
             let t1 = (exit - self.origin[a]) * self.inv_dir[a];
             // `f32::max`/`min` return the other operand when one is NaN.
@@ -173,10 +165,7 @@ pub(super) fn occluded<P: Primitives + ?Sized>(
             if node.is_leaf() {
                 let first = node.offset as usize;
                 let leaf = &indices[first..first + node.count as usize];
-                if leaf
-                    .iter()
-                    .any(|&p| prims.intersect(p as usize, ray, t_max).is_some())
-                {
+                if leaf.iter().any(|&p| prims.intersect(p as usize, ray, t_max).is_some()) {
                     return true;
                 }
             } else {

@@ -14,16 +14,11 @@ pub(super) fn validate<P: Primitives + ?Sized>(
 ) -> Result<(), String> {
     let n = prims.len();
     if indices.len() != n {
-        return Err(format!(
-            "built over {} primitives, queried with {n}",
-            indices.len()
-        ));
+        return Err(format!("built over {} primitives, queried with {n}", indices.len()));
     }
     let mut seen = vec![false; n];
     for &p in indices {
-        let slot = seen
-            .get_mut(p as usize)
-            .ok_or_else(|| format!("primitive index {p} out of range"))?;
+        let slot = seen.get_mut(p as usize).ok_or_else(|| format!("primitive index {p} out of range"))?;
         if std::mem::replace(slot, true) {
             return Err(format!("primitive {p} appears twice"));
         }
@@ -31,9 +26,7 @@ pub(super) fn validate<P: Primitives + ?Sized>(
     for &p in &indices[live.min(n)..] {
         let b = prims.bounds(p as usize);
         if !b.is_empty() && b.min.is_finite() && b.max.is_finite() {
-            return Err(format!(
-                "primitive {p} has finite bounds but is not in the tree"
-            ));
+            return Err(format!("primitive {p} has finite bounds but is not in the tree"));
         }
     }
     if nodes.is_empty() {
@@ -46,12 +39,7 @@ pub(super) fn validate<P: Primitives + ?Sized>(
 }
 
 /// Walks the tree depth first, first child before second, so leaves must tile `0..live` in order.
-fn check_tree<P: Primitives + ?Sized>(
-    nodes: &[Node],
-    indices: &[u32],
-    live: usize,
-    prims: &P,
-) -> Result<(), String> {
+fn check_tree<P: Primitives + ?Sized>(nodes: &[Node], indices: &[u32], live: usize, prims: &P) -> Result<(), String> {
     let mut next_prim = 0usize;
     // (node, parent, depth)
     let mut stack = vec![(0usize, usize::MAX, 0usize)];
@@ -67,9 +55,7 @@ fn check_tree<P: Primitives + ?Sized>(
             return Err(format!("node {i} is not inside its parent {parent}"));
         }
         if depth >= MAX_DEPTH {
-            return Err(format!(
-                "node {i} at depth {depth} would overflow the traversal stack"
-            ));
+            return Err(format!("node {i} at depth {depth} would overflow the traversal stack"));
         }
         if !node.is_leaf() {
             let second = node.offset as usize;
@@ -87,10 +73,7 @@ fn check_tree<P: Primitives + ?Sized>(
             return Err(format!("leaf {i} holds {count} primitives"));
         }
         if first != next_prim || first + count > live {
-            return Err(format!(
-                "leaf {i} covers {first}..{} out of order",
-                first + count
-            ));
+            return Err(format!("leaf {i} covers {first}..{} out of order", first + count));
         }
         next_prim += count;
         for &p in &indices[first..first + count] {

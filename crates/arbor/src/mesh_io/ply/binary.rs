@@ -127,15 +127,7 @@ pub(super) fn read_binary<E: Order>(
     nv: u64,
     out: &mut Out,
 ) -> Result<()> {
-    let mut src = Bin::<E> {
-        path,
-        bytes,
-        pos: h.body,
-        last: h.body,
-        start: h.body,
-        elem: None,
-        order: PhantomData,
-    };
+    let mut src = Bin::<E> { path, bytes, pos: h.body, last: h.body, start: h.body, elem: None, order: PhantomData };
     for (e, role) in h.elements.iter().zip(roles) {
         match (role, e.stride()) {
             (Role::Vertex(plan), Some(stride)) => vertices_fixed(&mut src, e, plan, stride, out)?,
@@ -168,9 +160,7 @@ fn vertices_fixed<E: Order>(
     let mut fields = Vec::new();
     let mut off = 0;
     for (p, slot) in e.props.iter().zip(&plan.slots) {
-        let Kind::Scalar(ty) = p.kind else {
-            unreachable!("stride() is Some")
-        };
+        let Kind::Scalar(ty) = p.kind else { unreachable!("stride() is Some") };
         if let Some(s) = *slot {
             fields.push((off, ty, s));
         }
@@ -207,28 +197,12 @@ fn vertices_fixed<E: Order>(
 
 /// Faces made of one index list: a loop specialised for the usual count and index types.
 fn faces_fast<E: Order>(src: &mut Bin<E>, e: &Element, nv: u64, out: &mut Out) -> Result<()> {
-    let Kind::List { count, item } = e.props[0].kind else {
-        unreachable!("index_list checked")
-    };
+    let Kind::List { count, item } = e.props[0].kind else { unreachable!("index_list checked") };
     match (count, item) {
-        (Ty::U8, Ty::I32) => faces_loop(
-            src,
-            e,
-            nv,
-            out,
-            (1, 4),
-            |b| i64::from(b[0]),
-            |b| i64::from(E::u32(arr(b)) as i32),
-        ),
-        (Ty::U8, Ty::U32) => faces_loop(
-            src,
-            e,
-            nv,
-            out,
-            (1, 4),
-            |b| i64::from(b[0]),
-            |b| i64::from(E::u32(arr(b))),
-        ),
+        (Ty::U8, Ty::I32) => {
+            faces_loop(src, e, nv, out, (1, 4), |b| i64::from(b[0]), |b| i64::from(E::u32(arr(b)) as i32))
+        }
+        (Ty::U8, Ty::U32) => faces_loop(src, e, nv, out, (1, 4), |b| i64::from(b[0]), |b| i64::from(E::u32(arr(b)))),
         _ => faces_loop(
             src,
             e,

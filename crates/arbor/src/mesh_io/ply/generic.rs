@@ -58,8 +58,7 @@ pub(super) fn read_element<'a, S: Source<'a>>(
             }
         }
         if let Role::Vertex(plan) = role {
-            plan.push(&vals, out)
-                .map_err(|s| plan.non_finite(e, i, s, vals[s], src.start()))?;
+            plan.push(&vals, out).map_err(|s| plan.non_finite(e, i, s, vals[s], src.start()))?;
         }
         src.end()?;
     }
@@ -125,11 +124,7 @@ fn list_len<'a, S: Source<'a>>(src: &mut S, ty: Ty) -> Result<u64> {
 /// stitch strips together are dropped.
 fn strip(s: &[u32], out: &mut Vec<[u32; 3]>) {
     for k in 2..s.len() {
-        let t = if k % 2 == 0 {
-            [s[k - 2], s[k - 1], s[k]]
-        } else {
-            [s[k - 1], s[k - 2], s[k]]
-        };
+        let t = if k % 2 == 0 { [s[k - 2], s[k - 1], s[k]] } else { [s[k - 1], s[k - 2], s[k]] };
         if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
             out.push(t);
         }
@@ -148,14 +143,7 @@ pub(super) struct Ascii<'a> {
 impl<'a> Ascii<'a> {
     pub(super) fn new(path: &'a Path, body: &'a [u8], first_line: u32) -> Self {
         let (lines, toks) = (Lines::new(body, first_line), Tokens::new(&[]));
-        Ascii {
-            path,
-            lines,
-            toks,
-            line: first_line,
-            col: 0,
-            elem: None,
-        }
+        Ascii { path, lines, toks, line: first_line, col: 0, elem: None }
     }
     fn token(&mut self) -> Result<&'a [u8]> {
         match self.toks.next() {
@@ -202,10 +190,7 @@ impl<'a> Source<'a> for Ascii<'a> {
             return Ok(());
         };
         let (name, i) = self.elem.map_or(("", 0), |(e, i)| (e.name.as_str(), i));
-        let msg = format!(
-            "unexpected value `{}` after the end of {name} {i}",
-            shown(tok)
-        );
+        let msg = format!("unexpected value `{}` after the end of {name} {i}", shown(tok));
         Err(Error::input(Location::at(self.path, self.line, col), msg))
     }
     fn here(&self) -> Location {

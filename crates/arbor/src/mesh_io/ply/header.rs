@@ -101,11 +101,7 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let err = |line, col, msg: String| Error::input(Location::at(path, line, col), msg);
     let mut lines = Lines::new(bytes, 1);
     if !matches!(lines.next(), Some((_, l)) if l.trim_ascii() == b"ply") {
-        return Err(err(
-            1,
-            0,
-            "not a PLY file (the first line must be `ply`)".into(),
-        ));
+        return Err(err(1, 0, "not a PLY file (the first line must be `ply`)".into()));
     }
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
@@ -127,9 +123,7 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 });
             }
             b"element" => {
-                let (Some((_, name)), Some((col, count)), None) =
-                    (toks.next(), toks.next(), toks.next())
-                else {
+                let (Some((_, name)), Some((col, count)), None) = (toks.next(), toks.next(), toks.next()) else {
                     let msg = "malformed element line (expected `element <name> <count>`)";
                     return Err(err(n, 0, msg.into()));
                 };
@@ -152,20 +146,12 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 };
                 let body = bytes.len() - lines.rest().len();
                 let body_line = lines.next_number();
-                return Ok(Header {
-                    format,
-                    elements,
-                    body,
-                    body_line,
-                });
+                return Ok(Header { format, elements, body, body_line });
             }
             _ => return Err(err(n, 1, format!("unknown header keyword `{}`", shown(kw)))),
         }
     }
-    Err(Error::input(
-        Location::file(path),
-        "header has no `end_header` line",
-    ))
+    Err(Error::input(Location::file(path), "header has no `end_header` line"))
 }
 
 fn parse_property(mut toks: Tokens, path: &Path, n: u32) -> Result<Property> {
@@ -175,18 +161,14 @@ fn parse_property(mut toks: Tokens, path: &Path, n: u32) -> Result<Property> {
                    or `property list <count type> <item type> <name>`)";
         err(0, msg.into())
     };
-    let ty = |(col, t): (u32, &[u8])| {
-        Ty::parse(t).ok_or_else(|| err(col, format!("unknown property type `{}`", shown(t))))
-    };
+    let ty =
+        |(col, t): (u32, &[u8])| Ty::parse(t).ok_or_else(|| err(col, format!("unknown property type `{}`", shown(t))));
     let first = toks.next().ok_or_else(bad)?;
     let kind = if first.1 == b"list" {
         let (col, c) = toks.next().ok_or_else(bad)?;
         let count = ty((col, c))?;
         if !count.is_int() {
-            let msg = format!(
-                "list count type must be an integer type, not `{}`",
-                shown(c)
-            );
+            let msg = format!("list count type must be an integer type, not `{}`", shown(c));
             return Err(err(col, msg));
         }
         let item = ty(toks.next().ok_or_else(bad)?)?;
@@ -218,10 +200,9 @@ pub(super) fn check_sizes(h: &Header, bytes: &[u8], path: &Path) -> Result<()> {
         if used + need > left {
             let rest = left - used;
             let msg = match h.format {
-                Format::Ascii => format!(
-                    "element `{}` claims {} entries but only {rest} lines are left for it",
-                    e.name, e.count
-                ),
+                Format::Ascii => {
+                    format!("element `{}` claims {} entries but only {rest} lines are left for it", e.name, e.count)
+                }
                 _ => format!(
                     "element `{}` claims {} entries (at least {need} {unit}) \
                      but only {rest} {unit} are left for it",

@@ -35,12 +35,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let header = parse_header(bytes, path)?;
     check_sizes(&header, bytes, path)?;
     let (roles, nv) = plan_roles(&header, path)?;
-    let faces: u64 = header
-        .elements
-        .iter()
-        .filter(|e| e.name == "face")
-        .map(|e| e.count)
-        .sum();
+    let faces: u64 = header.elements.iter().filter(|e| e.name == "face").map(|e| e.count).sum();
     let mut out = Out {
         positions: Vec::with_capacity(nv as usize),
         normals: Vec::new(),
@@ -65,12 +60,8 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
                 read_element(&mut src, e, role, nv, &mut out)?;
             }
         }
-        Format::Le => {
-            binary::read_binary::<binary::Le>(bytes, &header, &roles, path, nv, &mut out)?
-        }
-        Format::Be => {
-            binary::read_binary::<binary::Be>(bytes, &header, &roles, path, nv, &mut out)?
-        }
+        Format::Le => binary::read_binary::<binary::Le>(bytes, &header, &roles, path, nv, &mut out)?,
+        Format::Be => binary::read_binary::<binary::Be>(bytes, &header, &roles, path, nv, &mut out)?,
     }
     Ok(TriangleMesh {
         positions: out.positions,
@@ -106,10 +97,7 @@ fn plan_roles(h: &Header, path: &Path) -> Result<(Vec<Role>, u64)> {
                     return Err(err("a second `vertex` element".into()));
                 }
                 if e.count > u64::from(u32::MAX) {
-                    return Err(err(format!(
-                        "{} vertices do not fit in 32-bit indices",
-                        e.count
-                    )));
+                    return Err(err(format!("{} vertices do not fit in 32-bit indices", e.count)));
                 }
                 Role::Vertex(vertex_plan(e).map_err(err)?)
             }
@@ -148,11 +136,7 @@ fn vertex_plan(e: &Element) -> std::result::Result<VertexPlan, String> {
     }
     let normals = found[3..6].iter().all(|&f| f);
     let uvs = found[6] && found[7];
-    Ok(VertexPlan {
-        slots,
-        normals,
-        uvs,
-    })
+    Ok(VertexPlan { slots, normals, uvs })
 }
 
 fn index_list(e: &Element) -> std::result::Result<usize, String> {
@@ -201,11 +185,7 @@ impl VertexPlan {
     }
 
     fn non_finite(&self, e: &Element, i: u64, slot: usize, val: f32, loc: Location) -> Error {
-        let k = self
-            .slots
-            .iter()
-            .position(|&s| s == Some(slot))
-            .unwrap_or(0);
+        let k = self.slots.iter().position(|&s| s == Some(slot)).unwrap_or(0);
         let msg = format!("vertex {i}: non-finite {} ({val})", e.props[k].name);
         Error::input(loc, msg)
     }
@@ -217,10 +197,7 @@ fn index_error(what: &str, i: u64, idx: i64, nv: u64, loc: Location) -> Error {
 }
 
 fn truncated(path: &Path, pos: usize, e: &Element, i: u64, need: usize, left: usize) -> Error {
-    let msg = format!(
-        "unexpected end of file in {} {i} of {} (needs {need} more bytes, {left} left)",
-        e.name, e.count
-    );
+    let msg = format!("unexpected end of file in {} {i} of {} (needs {need} more bytes, {left} left)", e.name, e.count);
     Error::input(Location::byte(path, pos as u64), msg)
 }
 
@@ -235,16 +212,9 @@ mod tests {
     }
     impl W {
         fn new(le: bool, header: &str) -> W {
-            let format = if le {
-                "binary_little_endian"
-            } else {
-                "binary_big_endian"
-            };
+            let format = if le { "binary_little_endian" } else { "binary_big_endian" };
             let head = format!("ply\nformat {format} 1.0\n{header}end_header\n");
-            W {
-                le,
-                buf: head.into_bytes(),
-            }
+            W { le, buf: head.into_bytes() }
         }
         fn b(&mut self, le: &[u8]) -> &mut W {
             let mut v = le.to_vec();
@@ -300,10 +270,7 @@ element face 6\nproperty list uchar int vertex_index\nend_header\n\
     #[test]
     fn ply_ascii_crlf_and_trailing_blank_lines() {
         let crlf = CUBE.replace('\n', "\r\n") + "\r\n\r\n";
-        assert_eq!(
-            parse(crlf.as_bytes()).unwrap(),
-            parse(CUBE.as_bytes()).unwrap()
-        );
+        assert_eq!(parse(crlf.as_bytes()).unwrap(), parse(CUBE.as_bytes()).unwrap());
     }
 
     /// Normals first, an ignored colour in the middle, uv as `s t`, indices as uint.
@@ -312,17 +279,8 @@ element face 6\nproperty list uchar int vertex_index\nend_header\n\
 property float x\nproperty uchar red\nproperty float y\nproperty float z\nproperty float s\n\
 property float t\nelement face 1\nproperty list uchar uint vertex_indices\n";
         let mut w = W::new(le, header);
-        for (i, p) in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
-            .iter()
-            .enumerate()
-        {
-            w.f32(0.0)
-                .f32(0.0)
-                .f32(1.0)
-                .f32(p[0])
-                .u8(200)
-                .f32(p[1])
-                .f32(p[2]);
+        for (i, p) in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().enumerate() {
+            w.f32(0.0).f32(0.0).f32(1.0).f32(p[0]).u8(200).f32(p[1]).f32(p[2]);
             w.f32(i as f32 * 0.5).f32(0.25);
         }
         w.u8(3).i32(0).i32(1).i32(2);
@@ -335,20 +293,13 @@ property float t\nelement face 1\nproperty list uchar uint vertex_indices\n";
         assert_eq!(m.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
         assert_eq!(m.indices, vec![[0, 1, 2]]);
         assert_eq!(m.normals, Some(vec![Vec3::Z; 3]));
-        let uvs = vec![
-            Vec2::new(0.0, 0.25),
-            Vec2::new(0.5, 0.25),
-            Vec2::new(1.0, 0.25),
-        ];
+        let uvs = vec![Vec2::new(0.0, 0.25), Vec2::new(0.5, 0.25), Vec2::new(1.0, 0.25)];
         assert_eq!(m.uvs, Some(uvs));
     }
 
     #[test]
     fn ply_binary_be_matches_le() {
-        assert_eq!(
-            parse(&shuffled(false)).unwrap(),
-            parse(&shuffled(true)).unwrap()
-        );
+        assert_eq!(parse(&shuffled(false)).unwrap(), parse(&shuffled(true)).unwrap());
     }
 
     /// Every scalar type, an unused element with a list before the vertices, faces with an extra
@@ -372,12 +323,7 @@ element face 1\nproperty uchar flags\nproperty list ushort short vertex_indices\
     fn ply_all_scalar_types_and_skipped_lists() {
         for le in [true, false] {
             let m = parse(&odd_types(le)).unwrap();
-            let want = [
-                [0.5, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.0, 1.0, 0.0],
-                [0.0, -1.0, 3.0],
-            ];
+            let want = [[0.5, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, -1.0, 3.0]];
             assert_eq!(m.positions, want.map(Vec3::from_array).to_vec());
             assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
         }
@@ -385,8 +331,7 @@ element face 1\nproperty uchar flags\nproperty list ushort short vertex_indices\
 
     #[test]
     fn ply_ascii_faces_before_vertices_and_tristrips() {
-        let src =
-            "ply\nformat ascii 1.0\nelement tristrips 1\nproperty list int int vertex_indices\n\
+        let src = "ply\nformat ascii 1.0\nelement tristrips 1\nproperty list int int vertex_indices\n\
 element vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n\
 8 0 1 2 3 -1 2 2 4\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n";
         let m = parse(src.as_bytes()).unwrap();
@@ -426,9 +371,7 @@ element face 1\nproperty list uchar int vertex_indices\n";
         let at = w.buf.len() - 8;
         assert_eq!(
             err(&w.buf),
-            format!(
-                "m.ply: byte {at}: face 0: vertex index -1 out of range (the file has 3 vertices)"
-            )
+            format!("m.ply: byte {at}: face 0: vertex index -1 out of range (the file has 3 vertices)")
         );
     }
 
@@ -456,10 +399,7 @@ element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
         w.u8(2).f32(1.0).f32(2.0).f32(0.0);
         assert_eq!(
             err(&w.buf),
-            format!(
-                "m.ply: byte {}: unexpected end of file in vertex 0 of 1 (needs 12 more bytes, 4 left)",
-                head + 9
-            )
+            format!("m.ply: byte {}: unexpected end of file in vertex 0 of 1 (needs 12 more bytes, 4 left)", head + 9)
         );
         // The same through the generic path (a list in the vertex element).
         let header = "element vertex 1\nproperty list uchar float w\nproperty float x\n\
@@ -469,91 +409,54 @@ property float y\nproperty float z\n";
         w.u8(2).f32(1.0).f32(2.0).f32(0.0);
         assert_eq!(
             err(&w.buf),
-            format!(
-                "m.ply: byte {}: unexpected end of file in vertex 0 of 1 (needs 4 more bytes, 0 left)",
-                head + 13
-            )
+            format!("m.ply: byte {}: unexpected end of file in vertex 0 of 1 (needs 4 more bytes, 0 left)", head + 13)
         );
     }
 
     #[test]
     fn ply_header_claiming_too_many_elements_is_rejected() {
-        let mut w = W::new(
-            true,
-            "element vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n",
-        );
+        let mut w =
+            W::new(true, "element vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n");
         w.f32(0.0);
         assert_eq!(
             err(&w.buf),
             "m.ply:3: element `vertex` claims 1000000000000 entries (at least 12000000000000 bytes) but only 4 bytes are left for it"
         );
         let ascii = CUBE.replace("element face 6", "element face 7");
-        assert_eq!(
-            err(ascii.as_bytes()),
-            "m.ply:9: element `face` claims 7 entries but only 6 lines are left for it"
-        );
+        assert_eq!(err(ascii.as_bytes()), "m.ply:9: element `face` claims 7 entries but only 6 lines are left for it");
     }
 
     #[test]
     fn ply_index_out_of_range() {
         let ascii = CUBE.replace("4 2 6 7 3", "4 2 6 8 3");
-        assert_eq!(
-            err(ascii.as_bytes()),
-            "m.ply:24:7: face 4: vertex index 8 out of range (the file has 8 vertices)"
-        );
+        assert_eq!(err(ascii.as_bytes()), "m.ply:24:7: face 4: vertex index 8 out of range (the file has 8 vertices)");
         let mut bytes = shuffled(false);
         let n = bytes.len();
         bytes[n - 4..].copy_from_slice(&3u32.to_be_bytes());
         assert_eq!(
             err(&bytes),
-            format!(
-                "m.ply: byte {}: face 0: vertex index 3 out of range (the file has 3 vertices)",
-                n - 4
-            )
+            format!("m.ply: byte {}: face 0: vertex index 3 out of range (the file has 3 vertices)", n - 4)
         );
     }
 
     #[test]
     fn ply_nan_vertex() {
         let ascii = CUBE.replace("1 1 1\n", "1 nan 1\n");
-        assert_eq!(
-            err(ascii.as_bytes()),
-            "m.ply:17: vertex 5: non-finite y (NaN)"
-        );
-        let mut w = W::new(
-            true,
-            "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n",
-        );
-        w.f32(0.0)
-            .f32(0.0)
-            .f32(0.0)
-            .f32(1.0)
-            .f32(f32::INFINITY)
-            .f32(0.0);
+        assert_eq!(err(ascii.as_bytes()), "m.ply:17: vertex 5: non-finite y (NaN)");
+        let mut w = W::new(true, "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n");
+        w.f32(0.0).f32(0.0).f32(0.0).f32(1.0).f32(f32::INFINITY).f32(0.0);
         let at = w.buf.len() - 12;
-        assert_eq!(
-            err(&w.buf),
-            format!("m.ply: byte {at}: vertex 1: non-finite y (inf)")
-        );
+        assert_eq!(err(&w.buf), format!("m.ply: byte {at}: vertex 1: non-finite y (inf)"));
     }
 
     #[test]
     fn ply_face_with_two_vertices() {
         let ascii = CUBE.replace("4 0 4 5 1", "2 0 4");
-        assert_eq!(
-            err(ascii.as_bytes()),
-            "m.ply:22: face 2 has 2 vertices (a face needs at least 3)"
-        );
+        assert_eq!(err(ascii.as_bytes()), "m.ply:22: face 2 has 2 vertices (a face needs at least 3)");
         let mut bytes = shuffled(true);
         let n = bytes.len();
         bytes[n - 13] = 2;
-        assert_eq!(
-            err(&bytes),
-            format!(
-                "m.ply: byte {}: face 0 has 2 vertices (a face needs at least 3)",
-                n - 13
-            )
-        );
+        assert_eq!(err(&bytes), format!("m.ply: byte {}: face 0 has 2 vertices (a face needs at least 3)", n - 13));
     }
 
     #[test]
@@ -564,14 +467,8 @@ property float y\nproperty float z\n";
 
     #[test]
     fn ply_header_errors() {
-        assert_eq!(
-            err(b"PLY\n"),
-            "m.ply:1: not a PLY file (the first line must be `ply`)"
-        );
-        assert_eq!(
-            err(b"ply\nformat ascii 1.0\nelement vertex 0\n"),
-            "m.ply: header has no `end_header` line"
-        );
+        assert_eq!(err(b"PLY\n"), "m.ply:1: not a PLY file (the first line must be `ply`)");
+        assert_eq!(err(b"ply\nformat ascii 1.0\nelement vertex 0\n"), "m.ply: header has no `end_header` line");
         assert_eq!(
             err(b"ply\nformat text 1.0\nend_header\n"),
             "m.ply:2:8: unknown format `text` (expected ascii, binary_little_endian or binary_big_endian)"
@@ -597,26 +494,17 @@ property float y\nproperty float z\n";
             err(b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nend_header\n"),
             "m.ply:3: element `vertex` has no scalar property `z`"
         );
-        assert_eq!(
-            err(b"ply\nelement vertex 0\nend_header\n"),
-            "m.ply:3: no `format` line before `end_header`"
-        );
+        assert_eq!(err(b"ply\nelement vertex 0\nend_header\n"), "m.ply:3: no `format` line before `end_header`");
         assert_eq!(
             err(b"ply\nformat ascii 1.0\nelement face 0\nproperty list float int vertex_indices\nend_header\n"),
             "m.ply:4:15: list count type must be an integer type, not `float`"
         );
-        assert_eq!(
-            err(b"ply\nformat ascii 1.0\nend_header\n"),
-            "m.ply: no `vertex` element"
-        );
+        assert_eq!(err(b"ply\nformat ascii 1.0\nend_header\n"), "m.ply: no `vertex` element");
     }
 
     #[test]
     fn ply_ascii_extra_value_is_an_error() {
         let ascii = CUBE.replace("0 1 0\n", "0 1 0 7\n");
-        assert_eq!(
-            err(ascii.as_bytes()),
-            "m.ply:14:7: unexpected value `7` after the end of vertex 2"
-        );
+        assert_eq!(err(ascii.as_bytes()), "m.ply:14:7: unexpected value `7` after the end of vertex 2");
     }
 }

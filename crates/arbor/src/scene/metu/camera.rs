@@ -11,9 +11,7 @@ impl Reader<'_> {
     /// One `Camera`; `index` (from 0) names it when it has no id.
     pub(super) fn camera(&mut self, c: &Node, index: usize) -> Result<CameraDesc> {
         let p = self.path;
-        let id = c
-            .attr("id")
-            .map_or_else(|| (index + 1).to_string(), |a| a.trimmed().to_string());
+        let id = c.attr("id").map_or_else(|| (index + 1).to_string(), |a| a.trimmed().to_string());
         let look_at = match c.attr("type").map(|a| (a, a.trimmed())) {
             None => false,
             Some((_, "lookAt")) => true,
@@ -23,10 +21,7 @@ impl Reader<'_> {
             }
         };
         if let Some(h) = c.attr("handedness").filter(|h| h.trimmed() != "right") {
-            let msg = format!(
-                "Camera {id}: handedness '{}' not supported; right-handed used",
-                h.trimmed()
-            );
+            let msg = format!("Camera {id}: handedness '{}' not supported; right-handed used", h.trimmed());
             self.notes.plain(h.loc(p), msg);
         }
         let position = self.req(c, "Position")?.vec3(p)?;
@@ -35,15 +30,8 @@ impl Reader<'_> {
         let res_node = self.req(c, "ImageResolution")?;
         let res = res_node.ints(p)?;
         let (width, height) = match res[..] {
-            [w, h] if w > 0 && h > 0 && w <= u32::MAX as i64 && h <= u32::MAX as i64 => {
-                (w as u32, h as u32)
-            }
-            _ => {
-                return Err(self.err(
-                    res_node,
-                    "<ImageResolution>: expected two positive integers",
-                ))
-            }
+            [w, h] if w > 0 && h > 0 && w <= u32::MAX as i64 && h <= u32::MAX as i64 => (w as u32, h as u32),
+            _ => return Err(self.err(res_node, "<ImageResolution>: expected two positive integers")),
         };
         let name_node = self.req(c, "ImageName")?;
         let image_name = name_node.trimmed().to_string();
@@ -62,15 +50,7 @@ impl Reader<'_> {
             let fov_deg = self.req(c, "FovY")?.float(p)?;
             let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
             let right = top * width as f32 / height as f32;
-            (
-                gaze,
-                Window {
-                    left: -right,
-                    right,
-                    bottom: -top,
-                    top,
-                },
-            )
+            (gaze, Window { left: -right, right, bottom: -top, top })
         } else {
             let gaze = self.req(c, "Gaze")?.vec3(p)?;
             let np = self.req(c, "NearPlane")?;
@@ -80,25 +60,14 @@ impl Reader<'_> {
                 let msg = format!("<NearPlane> has {extra} numbers; only the first 4 are used");
                 self.notes.plain(np.loc(p), msg);
             }
-            (
-                gaze,
-                Window {
-                    left: v[0],
-                    right: v[1],
-                    bottom: v[2],
-                    top: v[3],
-                },
-            )
+            (gaze, Window { left: v[0], right: v[1], bottom: v[2], top: v[3] })
         };
         if gaze.length_squared() == 0.0 {
             return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
         }
         let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
             (None, None) => None,
-            (Some(f), Some(a)) => Some(Lens {
-                aperture: a.float(p)?,
-                focus_distance: f.float(p)?,
-            }),
+            (Some(f), Some(a)) => Some(Lens { aperture: a.float(p)?, focus_distance: f.float(p)? }),
             (Some(_), None) => return Err(self.err(c, "<Camera>: missing <ApertureSize>")),
             (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
         };

@@ -12,15 +12,9 @@ impl Reader<'_> {
     /// Every `Material`, numbered in file order; their ids map to those indices.
     pub(super) fn read_materials(&mut self, ms: &Node) -> Result<()> {
         for (i, m) in ms.all("Material").enumerate() {
-            let id = m
-                .attr("id")
-                .map_or_else(|| (i + 1).to_string(), |a| a.trimmed().to_string());
+            let id = m.attr("id").map_or_else(|| (i + 1).to_string(), |a| a.trimmed().to_string());
             let mat = self.material(m, id.clone())?;
-            if self
-                .materials
-                .insert(id.clone(), self.desc.materials.len())
-                .is_some()
-            {
+            if self.materials.insert(id.clone(), self.desc.materials.len()).is_some() {
                 return Err(self.err(m, format!("duplicate material id '{id}'")));
             }
             self.desc.materials.push(mat);
@@ -31,9 +25,8 @@ impl Reader<'_> {
     /// One `Material` whose id is `id`.
     fn material(&mut self, m: &Node, id: String) -> Result<MaterialDesc> {
         let p = self.path;
-        let color = |r: &mut Self, name: &str| -> Result<Option<Color>> {
-            r.one(m, name).map(|n| n.vec3(p)).transpose()
-        };
+        let color =
+            |r: &mut Self, name: &str| -> Result<Option<Color>> { r.one(m, name).map(|n| n.vec3(p)).transpose() };
         let ambient = self.req(m, "AmbientReflectance")?.vec3(p)?;
         let diffuse = self.req(m, "DiffuseReflectance")?.vec3(p)?;
         let specular = color(self, "SpecularReflectance")?.unwrap_or(Color::ZERO);
@@ -43,9 +36,9 @@ impl Reader<'_> {
         };
         let float = |r: &mut Self, name: &str| -> Result<f32> { r.req(m, name)?.float(p) };
         let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
-            Some((_, t)) if t == "mirror" => MaterialKind::Mirror {
-                reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
-            },
+            Some((_, t)) if t == "mirror" => {
+                MaterialKind::Mirror { reflectance: self.req(m, "MirrorReflectance")?.vec3(p)? }
+            }
             Some((_, t)) if t == "conductor" => MaterialKind::Conductor {
                 reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
                 eta: float(self, "RefractionIndex")?,
@@ -56,9 +49,7 @@ impl Reader<'_> {
                 absorption: color(self, "AbsorptionCoefficient")?.unwrap_or(Color::ZERO),
             },
             Some((a, t)) => {
-                let msg = format!(
-                    "Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)"
-                );
+                let msg = format!("Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)");
                 return Err(Error::input(a.loc(p), msg));
             }
             None => {
@@ -67,15 +58,9 @@ impl Reader<'_> {
                 let transparency = color(self, "Transparency")?.unwrap_or(Color::ZERO);
                 if transparency != Color::ZERO {
                     let eta = float(self, "RefractionIndex")?;
-                    MaterialKind::Transparent {
-                        eta,
-                        transparency,
-                        mirror,
-                    }
+                    MaterialKind::Transparent { eta, transparency, mirror }
                 } else if mirror != Color::ZERO {
-                    MaterialKind::Mirror {
-                        reflectance: mirror,
-                    }
+                    MaterialKind::Mirror { reflectance: mirror }
                 } else {
                     MaterialKind::BlinnPhong
                 }
@@ -93,23 +78,13 @@ impl Reader<'_> {
         if rough.is_some_and(|r| r.float(p).map_or(true, |v| v != 0.0)) {
             self.unsupported(m, "Roughness", "glossy reflection is");
         }
-        Ok(MaterialDesc {
-            id,
-            ambient,
-            diffuse,
-            specular,
-            phong_exponent,
-            kind,
-        })
+        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, kind })
     }
 
     /// The material an object names, as an index.
     pub(super) fn material_of(&mut self, o: &Node, name: &str) -> Result<usize> {
         let m = self.req(o, "Material")?;
         let id = m.trimmed();
-        self.materials
-            .get(id)
-            .copied()
-            .ok_or_else(|| self.err(m, format!("{name}: unknown material id '{id}'")))
+        self.materials.get(id).copied().ok_or_else(|| self.err(m, format!("{name}: unknown material id '{id}'")))
     }
 }

@@ -31,16 +31,8 @@ impl Reader<'_> {
         let mut pending = Vec::new();
         for o in &objects.children {
             let kind = o.name.as_str();
-            if !matches!(
-                kind,
-                "Mesh"
-                    | "LightMesh"
-                    | "Triangle"
-                    | "Sphere"
-                    | "LightSphere"
-                    | "Plane"
-                    | "MeshInstance"
-            ) {
+            if !matches!(kind, "Mesh" | "LightMesh" | "Triangle" | "Sphere" | "LightSphere" | "Plane" | "MeshInstance")
+            {
                 continue;
             }
             o.mark_used();
@@ -48,32 +40,21 @@ impl Reader<'_> {
             let name = format!("{kind} {}", id.as_deref().unwrap_or("(no id)"));
             if kind.starts_with("Light") {
                 let what = "emission not supported; rendered as an ordinary object";
-                self.notes
-                    .feature(o.loc(self.path), &format!("<{kind}>"), what);
+                self.notes.feature(o.loc(self.path), &format!("<{kind}>"), what);
                 o.child("Radiance").map(Node::mark_subtree_used);
             }
             self.unsupported(o, "MotionBlur", "motion blur is");
             self.unsupported(o, "Texture", "textures are");
             let (material, shape) = if kind == "MeshInstance" {
-                let base_id = o
-                    .attr("baseMeshId")
-                    .ok_or_else(|| self.err(o, format!("{name}: missing attribute baseMeshId")))?;
+                let base_id =
+                    o.attr("baseMeshId").ok_or_else(|| self.err(o, format!("{name}: missing attribute baseMeshId")))?;
                 let reset = match o.attr("resetTransform") {
                     Some(a) => a.boolean(self.path)?,
                     None => false,
                 };
                 let has_material = o.child("Material").is_some();
-                let material = if has_material {
-                    self.material_of(o, &name)?
-                } else {
-                    0
-                };
-                pending.push(Pending {
-                    object: self.desc.objects.len(),
-                    base_id,
-                    reset,
-                    has_material,
-                });
+                let material = if has_material { self.material_of(o, &name)? } else { 0 };
+                pending.push(Pending { object: self.desc.objects.len(), base_id, reset, has_material });
                 (material, ShapeDesc::Instance { base: 0 })
             } else {
                 let material = self.material_of(o, &name)?;
@@ -85,22 +66,13 @@ impl Reader<'_> {
                     mesh_ids.insert(id.clone(), self.desc.objects.len());
                 }
             }
-            self.desc.objects.push(ObjectDesc {
-                name,
-                material,
-                shape,
-                transform,
-                loc: o.loc(self.path),
-            });
+            self.desc.objects.push(ObjectDesc { name, material, shape, transform, loc: o.loc(self.path) });
         }
         for p in pending {
             let id = p.base_id.trimmed();
             let base = *mesh_ids.get(id).ok_or_else(|| {
                 let name = &self.desc.objects[p.object].name;
-                Error::input(
-                    p.base_id.loc(self.path),
-                    format!("{name}: unknown base mesh id '{id}'"),
-                )
+                Error::input(p.base_id.loc(self.path), format!("{name}: unknown base mesh id '{id}'"))
             })?;
             let (base_transform, base_material) = {
                 let b = &self.desc.objects[base];
@@ -128,18 +100,14 @@ impl Reader<'_> {
                     Some(a) if a.trimmed() == "smooth" => true,
                     Some(a) if a.trimmed() == "flat" => false,
                     Some(a) => {
-                        let msg =
-                            format!("{name}: unknown shadingMode '{}'; flat used", a.trimmed());
+                        let msg = format!("{name}: unknown shadingMode '{}'; flat used", a.trimmed());
                         self.notes.plain(a.loc(p), msg);
                         false
                     }
                     None => false,
                 };
                 let faces = self.req(o, "Faces")?;
-                ShapeDesc::Mesh {
-                    source: self.faces(faces, name)?,
-                    smooth,
-                }
+                ShapeDesc::Mesh { source: self.faces(faces, name)?, smooth }
             }
             "Triangle" => {
                 let ind = self.req(o, "Indices")?;
@@ -149,15 +117,9 @@ impl Reader<'_> {
                     return Err(self.err(ind, msg));
                 }
                 let mesh = self.compact(ind, name, &idx, 0)?;
-                ShapeDesc::Mesh {
-                    source: MeshSource::Inline(Arc::new(mesh)),
-                    smooth: false,
-                }
+                ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false }
             }
-            "Plane" => ShapeDesc::Plane {
-                point: self.vertex_ref(o, "Point", name)?,
-                normal: self.unit(o, "Normal")?,
-            },
+            "Plane" => ShapeDesc::Plane { point: self.vertex_ref(o, "Point", name)?, normal: self.unit(o, "Normal")? },
             _ => {
                 let center = self.vertex_ref(o, "Center", name)?;
                 let r = self.req(o, "Radius")?;
@@ -174,16 +136,12 @@ impl Reader<'_> {
     fn faces(&mut self, faces: &Node, name: &str) -> Result<MeshSource> {
         let p = self.path;
         if let Some(t) = faces.attr("type").filter(|t| t.trimmed() != "triangle") {
-            let msg = format!(
-                "<Faces>: unknown type '{}' (expected triangle)",
-                t.trimmed()
-            );
+            let msg = format!("<Faces>: unknown type '{}' (expected triangle)", t.trimmed());
             return Err(Error::input(t.loc(p), msg));
         }
         if let Some(a) = faces.attr("textureOffset") {
             let label = "attribute textureOffset of <Faces>";
-            self.notes
-                .feature(a.loc(p), label, "textures not supported; ignored");
+            self.notes.feature(a.loc(p), label, "textures not supported; ignored");
         }
         if let Some(ply) = faces.attr("plyFile") {
             if !faces.trimmed().is_empty() {
@@ -198,15 +156,10 @@ impl Reader<'_> {
         };
         let idx = faces.ints(p)?;
         if idx.len() % 3 != 0 {
-            let msg = format!(
-                "<Faces>: expected vertex id triples, found {} ids",
-                idx.len()
-            );
+            let msg = format!("<Faces>: expected vertex id triples, found {} ids", idx.len());
             return Err(self.err(faces, msg));
         }
-        Ok(MeshSource::Inline(Arc::new(
-            self.compact(faces, name, &idx, offset)?,
-        )))
+        Ok(MeshSource::Inline(Arc::new(self.compact(faces, name, &idx, offset)?)))
     }
 
     /// The triangles `idx` (1-based ids, plus `offset`) as a mesh of only the vertices they use.
@@ -223,22 +176,12 @@ impl Reader<'_> {
             });
             corners.push(i);
         }
-        mesh.indices = corners
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
+        mesh.indices = corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         Ok(mesh)
     }
 
     /// A 1-based vertex id (plus `offset`) as a 0-based index into the vertex data, or an error.
-    fn vertex_index(
-        &self,
-        at: &Node,
-        name: &str,
-        what: &str,
-        raw: i64,
-        offset: i64,
-    ) -> Result<usize> {
+    fn vertex_index(&self, at: &Node, name: &str, what: &str, raw: i64, offset: i64) -> Result<usize> {
         let id = raw.saturating_add(offset);
         let n = self.vertices.len();
         if id >= 1 && (id as u64) <= n as u64 {
@@ -248,9 +191,7 @@ impl Reader<'_> {
             0 => raw.to_string(),
             _ => format!("{raw} + vertexOffset {offset} = {id}"),
         };
-        let msg = format!(
-            "{name}: {what} {shown} out of range (VertexData has {n} vertices, numbered from 1)"
-        );
+        let msg = format!("{name}: {what} {shown} out of range (VertexData has {n} vertices, numbered from 1)");
         Err(self.err(at, msg))
     }
 
@@ -262,11 +203,7 @@ impl Reader<'_> {
             let msg = format!("<{child}>: expected one vertex id, found {}", ids.len());
             return Err(self.err(c, msg));
         };
-        let what = if child == "Center" {
-            "centre vertex"
-        } else {
-            "point vertex"
-        };
+        let what = if child == "Center" { "centre vertex" } else { "point vertex" };
         Ok(self.vertices[self.vertex_index(c, name, what, raw, 0)?])
     }
 }
