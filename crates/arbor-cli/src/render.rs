@@ -72,7 +72,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let parse_time = t0.elapsed();
     for w in &desc.warnings {
         if !args.quiet {
-            esay!("warning: {w}");
+            eprintln!("warning: {w}");
         }
     }
     let cameras: Vec<usize> = match &args.camera {
