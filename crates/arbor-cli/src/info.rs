@@ -24,7 +24,10 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     say!("scene      {}", crate::shown(&args.scene));
     say!(
         "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",
-        desc.background, desc.ambient, desc.max_depth, desc.shadow_epsilon
+        desc.background,
+        desc.ambient,
+        desc.max_depth,
+        desc.shadow_epsilon
     );
     for c in &desc.cameras {
         say!(

@@ -7,7 +7,12 @@
 //! - `Transformations` lists named transforms (`t1 s2 r1 c1`) applied left to right;
 //! - a look-at camera's window is `top = NearDistance·tan(FovY/2)`, `right = top·width/height`;
 //! - untyped (pre-2020) materials: a non-zero `Transparency` means glass, else a non-zero
-//!   `MirrorReflectance` means a mirror;
+//!   `MirrorReflectance` means a mirror. Only legacy files follow this rule: XML files in which no
+//!   material has a `type`. Files that type their materials, and the 2025 JSON form always, keep
+//!   untyped materials plain Blinn-Phong, as the official renderers do (the 2025 `raven.png` reference
+//!   shows no reflection from its untyped `MirrorReflectance` at depth 6);
+//! - an absent `MaxRecursionDepth` is 0 in XML (the 2024 official parser) and 6 in the 2025 JSON form,
+//!   whose `bunny_with_plane.png` reference shows its mirror plane with no depth given;
 //! - duplicated single-valued elements: the last one wins, with a warning;
 //! - what Arbor does not render (textures, motion blur, BRDFs, tone mapping...) is one warning per
 //!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
@@ -20,8 +25,17 @@ use super::{LightDesc, SceneDesc};
 use crate::math::{Mat4, Transform, Vec3};
 use crate::{Error, Location, Result};
 
-/// Reads the scene below the root element `root` of the file `path`.
-pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
+/// Which form of the schema a file is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// The XML of 2017-2024.
+    Xml,
+    /// The 2025 JSON conversion.
+    Json,
+}
+
+/// Reads the scene below the root element `root` of the file `path`, written in `form`.
+pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
     if root.name != "Scene" {
         return Err(Error::input(root.loc(path), format!("root element is <{}>, expected <Scene>", root.name)));
     }
@@ -29,7 +43,8 @@ pub fn read(root: &Node, path: &Path) -> Result<SceneDesc> {
     let mut r = Reader {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
-        desc: SceneDesc::new(path),
+        desc: SceneDesc { max_depth: if form == Form::Json { 6 } else { 0 }, ..SceneDesc::new(path) },
+        legacy: form == Form::Xml && !typed_materials(root),
         notes: Notes::default(),
         vertices: Vec::new(),
         transforms: HashMap::new(),
@@ -111,6 +126,18 @@ struct Reader<'a> {
     vertices: Vec<Vec3>,
     transforms: HashMap<String, Transform>,
     materials: HashMap<String, usize>,
+    /// A pre-2020 file: untyped materials take their kind from the elements present.
+    legacy: bool,
+}
+
+/// True when some material of the scene has a `type` attribute (the post-2020 schema). Looked up
+/// without marking anything as read.
+fn typed_materials(root: &Node) -> bool {
+    root.children
+        .iter()
+        .filter(|c| c.name == "Materials")
+        .flat_map(|m| m.children.iter().filter(|c| c.name == "Material"))
+        .any(|m| m.attrs.iter().any(|a| a.name == "type"))
 }
 
 fn vertex_data(v: &Node, path: &Path) -> Result<Vec<Vec3>> {

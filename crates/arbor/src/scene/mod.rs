@@ -35,12 +35,12 @@ pub fn load_desc(path: &Path) -> Result<SceneDesc> {
 pub fn parse_desc(text: &str, path: &Path) -> Result<SceneDesc> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "xml" => metu::read(&xml::parse(text, path)?, path),
+        "xml" => metu::read(&xml::parse(text, path)?, path, metu::Form::Xml),
         "json" => {
             if nyu_json::looks_like_nyu(text) {
                 nyu_json::parse(text, path)
             } else {
-                metu::read(&json::parse(text, path)?, path)
+                metu::read(&json::parse(text, path)?, path, metu::Form::Json)
             }
         }
         _ => Err(Error::input(Location::file(path), format!("unknown scene format '.{ext}' (expected .xml or .json)"))),

@@ -52,6 +52,7 @@ impl Reader<'_> {
                 let msg = format!("Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)");
                 return Err(Error::input(a.loc(p), msg));
             }
+            None if !self.legacy => MaterialKind::BlinnPhong,
             None => {
                 // Pre-2020 files have no type; the elements present say what the material is.
                 let mirror = color(self, "MirrorReflectance")?.unwrap_or(Color::ZERO);
