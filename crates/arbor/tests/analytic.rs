@@ -198,3 +198,21 @@ fn analytic_environment_seen_directly_and_in_a_mirror() {
     let (reflected, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
     assert_close(reflected.pixels[0], Color::new(0.0, 0.0, 0.3));
 }
+
+#[test]
+fn analytic_glass_is_not_shaded_from_inside() {
+    // The glass slab of the Beer's law test, now with ambient reflectance: only the front face, seen
+    // from outside, adds it; the back face, met from inside, only refracts.
+    let eta = 1.5f32;
+    let mut glass = material(0.3, 0.0, MaterialKind::Dielectric { eta, absorption: Color::ZERO });
+    glass.diffuse = Color::ZERO;
+    let wall = material(0.8, 0.0, MaterialKind::BlinnPhong);
+    let objects = vec![
+        object(quad(1.0, 5.0, true), 0),
+        object(quad(-1.0, 5.0, false), 0),
+        object(quad(-10.0, 50.0, true), 1),
+    ];
+    let f = ((eta - 1.0) / (eta + 1.0)).powi(2);
+    let want = Color::splat(30.0) + (1.0 - f) * (1.0 - f) * Color::splat(80.0);
+    assert_close(pixel(scene(vec![glass, wall], objects, vec![], 2)), want);
+}

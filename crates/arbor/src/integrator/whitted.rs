@@ -1,6 +1,7 @@
 //! Whitted-style recursive ray tracing as the METU and NYU courses define it: ambient plus Blinn-Phong
 //! from every light that a shadow ray reaches, plus the specular lobes of mirrors, conductors and
 //! dielectrics up to the recursion limit, with Beer's law along every segment travelled inside glass.
+//! Glass seen from inside gets no ambient or Blinn-Phong terms, only its lobes.
 //!
 //! Secondary ray origins are pushed off the surface by the scene's `ShadowRayEpsilon` along the
 //! geometric normal, to the side the new ray leaves from, so a ray never re-hits its own surface.
@@ -44,10 +45,13 @@ impl<'a> Whitted<'a> {
         let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
         let eps = scene.desc.shadow_epsilon;
 
-        let mut color = m.ambient * scene.desc.ambient;
+        // A refractive surface hit from inside only refracts and reflects: its ambient and Blinn-Phong
+        // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
+        let local = front || !matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Transparent { .. });
+        let mut color = if local { m.ambient * scene.desc.ambient } else { Color::ZERO };
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
         let shadow_origin = s.p + ng * eps;
-        for light in &scene.desc.lights {
+        for light in scene.desc.lights.iter().filter(|_| local) {
             let Some(ls) = sample_light(light, s.p, rng.next_2d()) else { continue };
             if ns.dot(ls.wi) <= 0.0 {
                 continue;
