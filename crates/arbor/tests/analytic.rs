@@ -207,12 +207,22 @@ fn analytic_glass_is_not_shaded_from_inside() {
     let mut glass = material(0.3, 0.0, MaterialKind::Dielectric { eta, absorption: Color::ZERO });
     glass.diffuse = Color::ZERO;
     let wall = material(0.8, 0.0, MaterialKind::BlinnPhong);
-    let objects = vec![
-        object(quad(1.0, 5.0, true), 0),
-        object(quad(-1.0, 5.0, false), 0),
-        object(quad(-10.0, 50.0, true), 1),
-    ];
+    let objects =
+        vec![object(quad(1.0, 5.0, true), 0), object(quad(-1.0, 5.0, false), 0), object(quad(-10.0, 50.0, true), 1)];
     let f = ((eta - 1.0) / (eta + 1.0)).powi(2);
     let want = Color::splat(30.0) + (1.0 - f) * (1.0 - f) * Color::splat(80.0);
     assert_close(pixel(scene(vec![glass, wall], objects, vec![], 2)), want);
+}
+
+#[test]
+fn analytic_scene_without_shadows_lights_occluded_points() {
+    // The occluder scene again, with shadow rays off (the NYU convention): the full diffuse term returns.
+    let m = material(0.25, 0.5, MaterialKind::BlinnPhong);
+    let sphere = object(ShapeDesc::Sphere { center: Vec3::ZERO, radius: 2.0 }, 0);
+    let blocker = object(quad(4.0, 0.5, false), 0);
+    let light = LightDesc::Point { position: Vec3::new(0.0, 0.0, 6.0), intensity: Color::splat(1600.0) };
+    let mut desc = scene(vec![m], vec![sphere, blocker], vec![light], 0);
+    desc.cameras[0].position = Vec3::new(0.0, 0.0, 3.0);
+    desc.shadows = false;
+    assert_close(pixel(desc), Color::splat(25.0 + 0.5 * 1600.0 / 16.0));
 }

@@ -251,7 +251,7 @@ fn readers_nyu_parallelogram_and_located_errors() {
     let path = dir.path().join("quad.json");
     std::fs::write(&path, text).unwrap();
     let d = load_desc(&path).unwrap();
-    assert_eq!((d.radiance_scale, d.max_depth, d.shadow_epsilon), (1.0, 5, 1e-4));
+    assert_eq!((d.radiance_scale, d.max_depth, d.shadow_epsilon, d.shadows), (1.0, 0, 1e-4, false));
     assert!(d.cameras[0].orthographic);
     assert_eq!(d.cameras[0].image_name, "quad.png");
     let glass = MaterialKind::Transparent { eta: 1.3, transparency: Vec3::splat(0.5), mirror: Vec3::ZERO };

@@ -56,14 +56,14 @@ impl<'a> Whitted<'a> {
             if ns.dot(ls.wi) <= 0.0 {
                 continue;
             }
-            *count += 1;
+            *count += scene.desc.shadows as u64;
             let shadow = if ls.dist.is_finite() {
                 Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
             } else {
                 Ray::new(shadow_origin, ls.wi)
             };
             let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
-            if scene.geometry.occluded(&shadow, t_max) {
+            if scene.desc.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
             color += blinn_phong(m, ns, ls.wi, -d) * ls.irradiance;

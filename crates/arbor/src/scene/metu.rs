@@ -326,7 +326,7 @@ mod tests {
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
         let path = Path::new("t.xml");
-        read(&xml::parse(&format!("<Scene>{body}</Scene>"), path)?, path)
+        read(&xml::parse(&format!("<Scene>{body}</Scene>"), path)?, path, Form::Xml)
     }
 
     const MATERIAL: &str = "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
@@ -378,7 +378,7 @@ mod tests {
     #[test]
     fn metu_root_must_be_scene_and_types_must_be_known() {
         let path = Path::new("t.xml");
-        let e = read(&xml::parse("<Scen/>", path).unwrap(), path).unwrap_err();
+        let e = read(&xml::parse("<Scen/>", path).unwrap(), path, Form::Xml).unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:1: root element is <Scen>, expected <Scene>");
         let body = MATERIAL.replace("id=\"1\"", "id=\"1\" type=\"glass\"");
         let e = read_xml(&body).unwrap_err();
