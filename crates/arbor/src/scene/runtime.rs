@@ -9,7 +9,7 @@ use super::desc::{MaterialDesc, SceneDesc};
 use crate::accel::{AccelKind, Hit};
 use crate::light::environment::EnvMap;
 use crate::math::{Ray, Vec3};
-use crate::Result;
+use crate::{Error, Location, Result};
 
 /// A scene ready to render.
 pub struct Scene {
@@ -43,7 +43,17 @@ impl Scene {
     pub fn build(desc: SceneDesc, kind: AccelKind, environment: Option<EnvMap>) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
-            None => desc.environment.as_deref().map(EnvMap::load).transpose()?,
+            None => match desc.environment.as_deref() {
+                None => None,
+                // A map the scene names but that cannot be read is the scene's fault, like a missing mesh.
+                Some(path) => Some(EnvMap::load(path).map_err(|e| match e {
+                    Error::Io { source, .. } => Error::input(
+                        Location::file(&desc.source),
+                        format!("cannot read environment map '{}': {source}", path.display()),
+                    ),
+                    other => other,
+                })?),
+            },
         };
         let start = Instant::now();
         let geometry = build_geometry(&desc, kind)?;
