@@ -14,12 +14,27 @@ pub struct InfoArgs {
     /// Scene file (.xml or .json). Without one, describes the built-in example.
     pub scene: Option<PathBuf>,
     /// Acceleration structure to build and report on.
-    #[arg(long, default_value = "bvh-sah", value_parser = |s: &str| s.parse::<AccelKind>())]
+    #[arg(long, default_value = "bvh-sah", value_parser = crate::render::parse_accel)]
     pub accel: AccelKind,
+    /// A build parameter of the structure, KEY=VALUE (repeatable).
+    #[arg(long = "accel-param", value_name = "KEY=VALUE")]
+    pub accel_params: Vec<String>,
+    /// List the acceleration structures and their parameters, and exit.
+    #[arg(long)]
+    pub accels: bool,
 }
 
 /// Runs `arbor info`.
 pub fn run(args: InfoArgs) -> Result<(), Failure> {
+    if args.accels {
+        for kind in AccelKind::ALL {
+            say!("{kind}");
+            for (key, what) in kind.param_keys() {
+                say!("    --accel-param {key}=VALUE    {what}");
+            }
+        }
+        return Ok(());
+    }
     let desc = crate::render::read_scene(&args.scene)?;
     say!("scene      {}", crate::shown(&args.scene));
     say!(
@@ -80,7 +95,8 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     for w in &desc.warnings {
         say!("warning    {w}");
     }
-    let scene = Scene::build(desc, args.accel, None)?;
+    let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
+    let scene = Scene::build(desc, &spec, None)?;
     let g = &scene.geometry.counts;
     say!(
         "geometry   {} triangles ({} degenerate), {} spheres, {} planes; bounds {} .. {}; meshes read in {:.1} ms",

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use arbor::accel::AccelKind;
+use arbor::accel::{AccelKind, AccelSpec};
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, RenderOptions};
 use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
@@ -25,9 +25,12 @@ pub struct RenderArgs {
     /// Folder for the images (created if missing); each camera's file name comes from the scene.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
-    /// Acceleration structure.
+    /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.
     #[arg(long, default_value = "bvh-sah", value_parser = parse_accel)]
     pub accel: AccelKind,
+    /// A build parameter of the structure, KEY=VALUE (repeatable; `arbor info --accels` lists them).
+    #[arg(long = "accel-param", value_name = "KEY=VALUE")]
+    pub accel_params: Vec<String>,
     /// Samples per pixel, overriding the scene's NumSamples.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub spp: Option<u32>,
@@ -52,8 +55,17 @@ pub struct RenderArgs {
     pub quiet: bool,
 }
 
-fn parse_accel(s: &str) -> Result<AccelKind, String> {
+/// Parses `--accel`.
+pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
     s.parse()
+}
+
+/// The structure and parameters named on the command line.
+pub fn accel_spec(kind: AccelKind, params: &[String]) -> Result<AccelSpec, Failure> {
+    let spec = AccelSpec::new(kind).with_params(params.iter().map(String::as_str)).map_err(arbor::Error::Invalid)?;
+    // Checked now, before any file is read.
+    spec.check().map_err(arbor::Error::Invalid)?;
+    Ok(spec)
 }
 
 /// Reads the scene named on the command line, or the built-in example.
@@ -95,7 +107,8 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
     }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
-    let scene = Scene::build(desc, args.accel, env)?;
+    let spec = accel_spec(args.accel, &args.accel_params)?;
+    let scene = Scene::build(desc, &spec, env)?;
     let opts = RenderOptions {
         spp: args.spp,
         cull_backfaces: if args.cull {

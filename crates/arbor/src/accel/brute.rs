@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use super::{Accel, AccelStats, Hit, Primitives};
+use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray};
 
 /// No structure at all; only the bounds are kept.
@@ -26,6 +26,8 @@ impl BruteForce {
             nodes: 1,
             leaves: 1,
             max_depth: 0,
+            mean_depth: 0.0,
+            refs_per_prim: 1.0,
             mean_leaf_prims: len as f64,
             sah_cost: len as f64,
             bytes: std::mem::size_of::<Self>(),
@@ -52,6 +54,27 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
             }
         }
         best
+    }
+
+    fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
+        counts.nodes += 1;
+        let mut best: Option<Hit> = None;
+        let mut limit = t_max;
+        for i in 0..self.len {
+            if let Some(h) = prims.intersect_counted(i, ray, limit, counts) {
+                limit = h.t;
+                best = Some(Hit::new(i as u32, h));
+            }
+        }
+        best
+    }
+
+    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+        if depth == 0 && !self.bounds.is_empty() {
+            vec![self.bounds]
+        } else {
+            Vec::new()
+        }
     }
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {

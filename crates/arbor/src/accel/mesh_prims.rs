@@ -6,7 +6,7 @@
 //! `min`/`max` of a NaN keeps the other operand), which is harmless: such a triangle is never hit.
 
 use super::{PrimHit, Primitives};
-use crate::geometry::{intersect_triangle, TriangleMesh};
+use crate::geometry::{clip_triangle_bounds, intersect_triangle, triangle_overlaps_box, TriangleMesh};
 use crate::math::{Aabb, Ray};
 
 impl Primitives for TriangleMesh {
@@ -25,6 +25,16 @@ impl Primitives for TriangleMesh {
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
         let [a, b, c] = self.triangle(i);
         intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit { t: h.t, u: h.b1, v: h.b2 })
+    }
+
+    fn overlaps_box(&self, i: usize, b: &Aabb) -> bool {
+        let [p, q, r] = self.triangle(i);
+        triangle_overlaps_box(p, q, r, b)
+    }
+
+    fn clipped_bounds(&self, i: usize, b: &Aabb) -> Aabb {
+        let [p, q, r] = self.triangle(i);
+        clip_triangle_bounds(p, q, r, b)
     }
 }
 

@@ -1,14 +1,21 @@
 //! Acceleration structures: one contract ([`Accel`]) in the vocabulary of pbrt and Embree, over any set
-//! of bounded primitives ([`Primitives`]), and one factory ([`build`]) selected by [`AccelKind`].
+//! of bounded primitives ([`Primitives`]), and one factory ([`build`], [`build_with`]) selected by
+//! [`AccelKind`] and tuned by each structure's `*Params` ([`AccelSpec`]).
 //!
 //! Every structure returns exactly the hit brute force returns: the smallest `t` in `(0, t_max)`, and
 //! among primitives hit at that same `t`, the one with the lowest index. Structures store only primitive
 //! indices; the primitives themselves are passed to each query, which keeps builders free of geometry
-//! and lets one structure type serve triangles, spheres or whole objects.
+//! and lets one structure type serve triangles, spheres or whole objects (the two-level scene).
+//!
+//! One folder per structure: `brute.rs`, `octree/`, `kdtree/`, `bvh/` (median, binned SAH and bottom-up
+//! builders sharing one node layout and one traversal).
 
 mod brute;
 pub mod bvh;
+pub mod kdtree;
 mod mesh_prims;
+pub mod octree;
+mod params;
 
 use std::fmt;
 use std::str::FromStr;
@@ -17,7 +24,10 @@ use std::time::Duration;
 use crate::math::{Aabb, Ray, Vec3};
 
 pub use brute::BruteForce;
-pub use bvh::{Bvh, BvhParams};
+pub use bvh::{BottomUpParams, Bvh, BvhParams};
+pub use kdtree::{KdTree, KdTreeParams};
+pub use octree::{Octree, OctreeParams};
+pub use params::{AccelSpec, Params};
 
 /// A hit on one primitive, before its index is known.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,6 +85,31 @@ pub trait Primitives: Sync {
     }
     /// The hit of `ray` with primitive `i` in `(0, t_max)`.
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit>;
+    /// [`Primitives::intersect`], adding the work done to `counts` (one primitive test by default; a
+    /// primitive that is itself a structure, as objects of the two-level scene are, adds its traversal).
+    fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {
+        counts.prims += 1;
+        self.intersect(i, ray, t_max)
+    }
+    /// Whether primitive `i` has a point in `b` (for structures that put a primitive in every cell it
+    /// touches). The default, bounds overlap, is conservative; triangles answer exactly.
+    fn overlaps_box(&self, i: usize, b: &Aabb) -> bool {
+        self.bounds(i).overlaps(b)
+    }
+    /// The bounds of the part of primitive `i` inside `b` ("perfect splits" of kd-trees). The default,
+    /// bounds cut by `b`, is conservative; triangles are clipped exactly.
+    fn clipped_bounds(&self, i: usize, b: &Aabb) -> Aabb {
+        self.bounds(i).intersection(*b)
+    }
+}
+
+/// The work one query did, for the traversal-cost heatmap and benchmarks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TraversalCounts {
+    /// Nodes (cells) visited.
+    pub nodes: u32,
+    /// Primitives tested.
+    pub prims: u32,
 }
 
 /// Counters that describe a built structure, for `arbor info`, the render summary and benchmarks.
@@ -90,6 +125,11 @@ pub struct AccelStats {
     pub leaves: usize,
     /// Depth of the deepest leaf (the root has depth 0).
     pub max_depth: usize,
+    /// Mean depth of the leaves.
+    pub mean_depth: f64,
+    /// Primitive references in leaves per primitive: 1 for hierarchies, more where cells share
+    /// primitives (octree, kd-tree).
+    pub refs_per_prim: f64,
     /// Mean primitive references per non-empty leaf.
     pub mean_leaf_prims: f64,
     /// Surface-area-heuristic cost of the tree (traversal cost 1, intersection cost 1), 0 where meaningless.
@@ -110,8 +150,12 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool;
     /// Build statistics.
     fn stats(&self) -> AccelStats;
-    /// Checks the structure's invariants (children inside parents, every primitive reachable once).
+    /// Checks the structure's invariants (children inside parents, every primitive reachable).
     fn validate(&self, prims: &P) -> Result<(), String>;
+    /// [`Accel::intersect`], adding the nodes visited and primitives tested to `counts`.
+    fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit>;
+    /// The boxes of the nodes (cells) at `depth` below the root, for the boxes debug view.
+    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb>;
 }
 
 /// The structures Arbor can build.
@@ -119,19 +163,49 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
 pub enum AccelKind {
     /// Tests every primitive: the reference.
     Brute,
-    /// Top-down bounding volume hierarchy with binned surface-area-heuristic splits.
+    /// Regular octree over the scene's bounding cube; primitives go into every cell they overlap.
+    Octree,
+    /// Kd-tree with surface-area-heuristic splits (Wald and Havran 2006).
+    KdTree,
+    /// Bounding volume hierarchy split at the median centroid of the longest axis.
+    BvhMedian,
+    /// Bounding volume hierarchy with binned surface-area-heuristic splits (the default).
     BvhSah,
+    /// Bounding volume hierarchy built bottom-up by agglomerative clustering (greedy or PLOC).
+    BvhBottomUp,
 }
 
 impl AccelKind {
     /// Every kind, in the order they are reported.
-    pub const ALL: &'static [AccelKind] = &[AccelKind::Brute, AccelKind::BvhSah];
+    pub const ALL: &'static [AccelKind] = &[
+        AccelKind::Brute,
+        AccelKind::Octree,
+        AccelKind::KdTree,
+        AccelKind::BvhMedian,
+        AccelKind::BvhSah,
+        AccelKind::BvhBottomUp,
+    ];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             AccelKind::Brute => "brute",
+            AccelKind::Octree => "octree",
+            AccelKind::KdTree => "kdtree",
+            AccelKind::BvhMedian => "bvh-median",
             AccelKind::BvhSah => "bvh-sah",
+            AccelKind::BvhBottomUp => "bvh-bottom-up",
+        }
+    }
+
+    /// The build parameters this kind takes (`--accel-param KEY=VALUE`), with what they mean.
+    pub fn param_keys(self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            AccelKind::Brute => &[],
+            AccelKind::Octree => OctreeParams::KEYS,
+            AccelKind::KdTree => KdTreeParams::KEYS,
+            AccelKind::BvhMedian | AccelKind::BvhSah => BvhParams::KEYS,
+            AccelKind::BvhBottomUp => BottomUpParams::KEYS,
         }
     }
 }
@@ -152,16 +226,45 @@ impl FromStr for AccelKind {
     }
 }
 
-/// Builds a structure of `kind` over `prims` (pbrt's `CreateAccelerator`). In debug builds the result
-/// is validated before it is returned.
+impl AccelSpec {
+    /// Checks that every parameter applies to the kind and parses, without building anything.
+    pub fn check(&self) -> Result<(), String> {
+        match self.kind {
+            AccelKind::Brute => self.parse::<params::NoParams>().map(drop),
+            AccelKind::Octree => self.parse::<OctreeParams>().map(drop),
+            AccelKind::KdTree => self.parse::<KdTreeParams>().map(drop),
+            AccelKind::BvhMedian | AccelKind::BvhSah => self.parse::<BvhParams>().map(drop),
+            AccelKind::BvhBottomUp => self.parse::<BottomUpParams>().map(drop),
+        }
+    }
+}
+
+/// Builds a structure of `kind` with its default parameters over `prims` (pbrt's `CreateAccelerator`).
+/// In debug builds the result is validated before it is returned.
 pub fn build<P: Primitives + ?Sized + 'static>(kind: AccelKind, prims: &P) -> Box<dyn Accel<P>> {
-    let accel: Box<dyn Accel<P>> = match kind {
-        AccelKind::Brute => Box::new(BruteForce::build(prims)),
-        AccelKind::BvhSah => Box::new(Bvh::build_sah(prims, &BvhParams::default())),
+    match build_with(&AccelSpec::new(kind), prims) {
+        Ok(accel) => accel,
+        Err(e) => unreachable!("default parameters are always valid: {e}"),
+    }
+}
+
+/// Builds the structure `spec` describes over `prims`; an error names a parameter that does not apply
+/// or does not parse. In debug builds the result is validated before it is returned.
+pub fn build_with<P: Primitives + ?Sized + 'static>(spec: &AccelSpec, prims: &P) -> Result<Box<dyn Accel<P>>, String> {
+    let accel: Box<dyn Accel<P>> = match spec.kind {
+        AccelKind::Brute => {
+            spec.parse::<params::NoParams>()?;
+            Box::new(BruteForce::build(prims))
+        }
+        AccelKind::Octree => Box::new(Octree::build(prims, &spec.parse()?)),
+        AccelKind::KdTree => Box::new(KdTree::build(prims, &spec.parse()?)),
+        AccelKind::BvhMedian => Box::new(Bvh::build_median(prims, &spec.parse()?)),
+        AccelKind::BvhSah => Box::new(Bvh::build_sah(prims, &spec.parse()?)),
+        AccelKind::BvhBottomUp => Box::new(Bvh::build_bottom_up(prims, &spec.parse()?)),
     };
     #[cfg(debug_assertions)]
     if let Err(e) = accel.validate(prims) {
-        panic!("{kind} built an invalid structure: {e}");
+        panic!("{} built an invalid structure: {e}", spec.kind);
     }
-    accel
+    Ok(accel)
 }

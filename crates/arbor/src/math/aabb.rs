@@ -82,6 +82,16 @@ impl Aabb {
             2
         }
     }
+    /// The box common to both (empty when they do not meet).
+    #[inline]
+    pub fn intersection(self, o: Aabb) -> Self {
+        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
+    }
+    /// True when the boxes share at least a point (touching counts).
+    #[inline]
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        self.min.cmple(o.max).all() && o.min.cmple(self.max).all()
+    }
     /// True when `o` lies inside this box (boundaries included).
     #[inline]
     pub fn contains(&self, o: &Aabb) -> bool {

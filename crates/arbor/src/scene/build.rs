@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
-use crate::accel::{self, Accel, AccelKind, AccelStats, Hit, PrimHit, Primitives};
+use crate::accel::{self, Accel, AccelSpec, AccelStats, Hit, PrimHit, Primitives};
 use crate::geometry::{intersect_triangle, Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::{Error, Result};
@@ -131,8 +131,8 @@ impl SceneGeometry {
     }
 }
 
-/// Loads the meshes of `desc` and builds its geometry under a structure of `kind`.
-pub fn build_geometry(desc: &SceneDesc, kind: AccelKind) -> Result<SceneGeometry> {
+/// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes.
+pub fn build_geometry(desc: &SceneDesc, spec: &AccelSpec) -> Result<SceneGeometry> {
     let start = Instant::now();
     let meshes = load_mesh_files(desc)?;
     let mesh_load = start.elapsed();
@@ -178,7 +178,7 @@ pub fn build_geometry(desc: &SceneDesc, kind: AccelKind) -> Result<SceneGeometry
         planes: planes.len(),
         mesh_load,
     };
-    let accel = accel::build(kind, &prims);
+    let accel = accel::build_with(spec, &prims).map_err(Error::Invalid)?;
     Ok(SceneGeometry { prims, accel, planes, counts })
 }
 

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::build::{build_geometry, SceneGeometry};
 use super::desc::{MaterialDesc, SceneDesc};
-use crate::accel::{AccelKind, Hit};
+use crate::accel::{AccelSpec, Hit};
 use crate::light::environment::EnvMap;
 use crate::math::{Ray, Vec3};
 use crate::{Error, Location, Result};
@@ -40,7 +40,7 @@ pub struct Surface {
 
 impl Scene {
     /// Loads the meshes and builds the structure. `environment` overrides the scene's own map.
-    pub fn build(desc: SceneDesc, kind: AccelKind, environment: Option<EnvMap>) -> Result<Scene> {
+    pub fn build(desc: SceneDesc, spec: &AccelSpec, environment: Option<EnvMap>) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
             None => match desc.environment.as_deref() {
@@ -56,7 +56,7 @@ impl Scene {
             },
         };
         let start = Instant::now();
-        let geometry = build_geometry(&desc, kind)?;
+        let geometry = build_geometry(&desc, spec)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
         Ok(Scene { desc, geometry, environment, build_time })
     }

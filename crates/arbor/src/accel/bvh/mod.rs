@@ -20,13 +20,17 @@
 //! in parallel; the result does not depend on the thread count. A query is O(log n) on well-distributed
 //! scenes; memory is 32 bytes per node (about `2n / leaf size` nodes) plus 4 bytes per primitive.
 
+mod bottom_up;
 mod build;
 mod traverse;
 mod validate;
 
 use std::time::{Duration, Instant};
 
-use super::{Accel, AccelStats, Hit, Primitives};
+pub use bottom_up::BottomUpParams;
+
+use super::params::{parse_value, unknown_key};
+use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
 /// Largest number of primitives in one leaf, whatever the parameters: a leaf of coincident centroids
@@ -130,6 +134,25 @@ impl BvhParams {
     }
 }
 
+impl Params for BvhParams {
+    const KEYS: &'static [(&'static str, &'static str)] = &[
+        ("leaf", "most primitives in a leaf that the SAH may keep (1-64)"),
+        ("bins", "SAH bins along the split axis (2-32)"),
+        ("traversal-cost", "cost of a node visit relative to a primitive test"),
+        ("intersection-cost", "cost of a primitive test"),
+    ];
+    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
+        match key {
+            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
+            "bins" => self.bins = parse_value(key, value)?,
+            "traversal-cost" => self.traversal_cost = parse_value(key, value)?,
+            "intersection-cost" => self.intersection_cost = parse_value(key, value)?,
+            _ => return Err(unknown_key("bvh", key, Self::KEYS)),
+        }
+        Ok(())
+    }
+}
+
 /// A bounding volume hierarchy over primitive indices.
 #[derive(Debug, Clone)]
 pub struct Bvh {
@@ -145,6 +168,20 @@ impl Bvh {
         let start = Instant::now();
         let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
         Bvh::from_flat(nodes, prim_indices, live, "bvh-sah", start)
+    }
+
+    /// PLACEHOLDER until the median builder lands: the SAH build.
+    pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
+        let start = Instant::now();
+        let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
+        Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
+    }
+
+    /// PLACEHOLDER until the bottom-up builder lands: the SAH build.
+    pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, _params: &BottomUpParams) -> Bvh {
+        let start = Instant::now();
+        let (nodes, prim_indices, live) = build::build_sah(prims, &BvhParams::default());
+        Bvh::from_flat(nodes, prim_indices, live, "bvh-bottom-up", start)
     }
 
     /// Wraps a flat node array written by any builder (the traversal and checks are shared), and
@@ -196,12 +233,14 @@ impl Bvh {
             }
         };
         let mut leaf_prims = 0usize;
+        let mut depth_sum = 0usize;
         let mut stack = vec![(0usize, 0usize)];
         while let Some((i, depth)) = stack.pop() {
             let n = &self.nodes[i];
             stats.max_depth = stats.max_depth.max(depth);
             if n.is_leaf() {
                 stats.leaves += 1;
+                depth_sum += depth;
                 leaf_prims += n.count as usize;
                 stats.sah_cost += rel(n) * n.count as f64;
             } else {
@@ -211,6 +250,8 @@ impl Bvh {
             }
         }
         stats.mean_leaf_prims = leaf_prims as f64 / stats.leaves as f64;
+        stats.mean_depth = depth_sum as f64 / stats.leaves as f64;
+        stats.refs_per_prim = if stats.primitives > 0 { leaf_prims as f64 / stats.primitives as f64 } else { 0.0 };
         stats
     }
 }
@@ -230,7 +271,33 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
-        traverse::intersect(&self.nodes, &self.prim_indices, prims, ray, t_max)
+        traverse::intersect::<P, false>(
+            &self.nodes,
+            &self.prim_indices,
+            prims,
+            ray,
+            t_max,
+            &mut TraversalCounts::default(),
+        )
+    }
+
+    fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
+        traverse::intersect::<P, true>(&self.nodes, &self.prim_indices, prims, ray, t_max, counts)
+    }
+
+    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+        let mut out = Vec::new();
+        let mut stack = if self.nodes.is_empty() { vec![] } else { vec![(0usize, 0usize)] };
+        while let Some((i, d)) = stack.pop() {
+            let n = &self.nodes[i];
+            if d == depth {
+                out.push(n.bounds());
+            } else if !n.is_leaf() {
+                stack.push((n.offset as usize, d + 1));
+                stack.push((i + 1, d + 1));
+            }
+        }
+        out
     }
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {

@@ -22,7 +22,7 @@
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 
 use super::{Node, MAX_DEPTH};
-use crate::accel::{Hit, Primitives};
+use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
 /// Slack of the box test, relative to the box's extent in `t` along the ray's major axis (2^-16, about
@@ -94,13 +94,15 @@ fn trivially_misses(nodes: &[Node], ray: &Ray, t_max: f32) -> bool {
     nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
 }
 
-/// The closest hit in `(0, t_max)`, ties to the lowest primitive index.
-pub(super) fn intersect<P: Primitives + ?Sized>(
+/// The closest hit in `(0, t_max)`, ties to the lowest primitive index. With `COUNT`, the nodes visited
+/// and primitives tested are added to `counts` (compiled out otherwise).
+pub(super) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
     nodes: &[Node],
     indices: &[u32],
     prims: &P,
     ray: &Ray,
     t_max: f32,
+    counts: &mut TraversalCounts,
 ) -> Option<Hit> {
     if trivially_misses(nodes, ray, t_max) {
         return None;
@@ -115,11 +117,19 @@ pub(super) fn intersect<P: Primitives + ?Sized>(
     let mut i = 0usize;
     loop {
         let node = &nodes[i];
+        if COUNT {
+            counts.nodes += 1;
+        }
         if test.hits(node, t_far) {
             if node.is_leaf() {
                 let first = node.offset as usize;
                 for &prim in &indices[first..first + node.count as usize] {
-                    if let Some(h) = prims.intersect(prim as usize, ray, t_query) {
+                    let h = if COUNT {
+                        prims.intersect_counted(prim as usize, ray, t_query, counts)
+                    } else {
+                        prims.intersect(prim as usize, ray, t_query)
+                    };
+                    if let Some(h) = h {
                         let hit = Hit::new(prim, h);
                         if hit.beats(&best) {
                             t_far = hit.t;
