@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
-use crate::accel::{self, Accel, AccelSpec, AccelStats, Hit, PrimHit, Primitives};
+use crate::accel::{self, Accel, AccelSpec, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
 use crate::geometry::{intersect_triangle, Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::{Error, Result};
@@ -110,6 +110,29 @@ impl SceneGeometry {
             }
         }
         best
+    }
+
+    /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested to `counts` (the
+    /// traversal-cost heatmap).
+    pub fn intersect_counted(&self, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
+        if !ray.is_valid() {
+            return None;
+        }
+        let mut best = self.accel.intersect_counted(&self.prims, ray, t_max, counts);
+        let base = self.prims.len() as u32;
+        for (k, (plane, _)) in self.planes.iter().enumerate() {
+            counts.prims += 1;
+            let limit = best.map_or(t_max, |h| h.t);
+            if let Some(t) = plane.intersect(ray, limit) {
+                best = Some(Hit { t, prim: base + k as u32, u: 0.0, v: 0.0 });
+            }
+        }
+        best
+    }
+
+    /// The world-space boxes of the structure's nodes at `depth` (the boxes debug view).
+    pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+        self.accel.boxes_at_depth(depth)
     }
 
     /// Whether anything lies on `ray` in `(0, t_max)`.
