@@ -508,9 +508,9 @@ impl Primitives for Shapes {
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
         match &self.0[i] {
             Shape::Triangle([a, b, c]) => {
-                intersect_triangle(ray, *a, *b, *c, t_max).map(|h| PrimHit { t: h.t, u: h.b1, v: h.b2 })
+                intersect_triangle(ray, *a, *b, *c, t_max).map(|h| PrimHit::new(h.t, h.b1, h.b2))
             }
-            Shape::Sphere(s) => s.intersect(ray, t_max).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+            Shape::Sphere(s) => s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0)),
         }
     }
 }

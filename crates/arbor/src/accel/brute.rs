@@ -78,7 +78,7 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
     }
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
-        (0..self.len).any(|i| prims.intersect(i, ray, t_max).is_some())
+        (0..self.len).any(|i| prims.occludes(i, ray, t_max))
     }
 
     fn stats(&self) -> AccelStats {

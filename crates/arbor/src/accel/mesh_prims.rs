@@ -24,7 +24,7 @@ impl Primitives for TriangleMesh {
     #[inline]
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
         let [a, b, c] = self.triangle(i);
-        intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit { t: h.t, u: h.b1, v: h.b2 })
+        intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit::new(h.t, h.b1, h.b2))
     }
 
     fn overlaps_box(&self, i: usize, b: &Aabb) -> bool {

@@ -38,6 +38,17 @@ pub struct PrimHit {
     pub u: f32,
     /// Second surface parameter (the weight of vertex 2 for triangles).
     pub v: f32,
+    /// For a primitive that holds primitives of its own (an object of the two-level scene), which one
+    /// was hit; 0 otherwise.
+    pub sub: u32,
+}
+
+impl PrimHit {
+    /// A hit on a simple primitive.
+    #[inline]
+    pub fn new(t: f32, u: f32, v: f32) -> Self {
+        PrimHit { t, u, v, sub: 0 }
+    }
 }
 
 /// The closest hit found by a structure.
@@ -51,15 +62,18 @@ pub struct Hit {
     pub u: f32,
     /// Surface parameters, see [`PrimHit`].
     pub v: f32,
+    /// The primitive hit inside primitive `prim`, see [`PrimHit::sub`].
+    pub sub: u32,
 }
 
 impl Hit {
     /// `prim` and `h` as a hit.
     #[inline]
     pub fn new(prim: u32, h: PrimHit) -> Self {
-        Hit { t: h.t, prim, u: h.u, v: h.v }
+        Hit { t: h.t, prim, u: h.u, v: h.v, sub: h.sub }
     }
-    /// True when this hit should replace `best` (closer, or as close with a lower index).
+    /// True when this hit should replace `best` (closer, or as close with a lower index). Hits inside
+    /// one primitive at equal `t` were already resolved by that primitive's own structure.
     #[inline]
     pub fn beats(&self, best: &Option<Hit>) -> bool {
         match best {
@@ -85,6 +99,11 @@ pub trait Primitives: Sync {
     }
     /// The hit of `ray` with primitive `i` in `(0, t_max)`.
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit>;
+    /// Whether primitive `i` is hit anywhere in `(0, t_max)` (shadow rays). The default asks for the
+    /// closest hit; primitives that are structures stop at the first.
+    fn occludes(&self, i: usize, ray: &Ray, t_max: f32) -> bool {
+        self.intersect(i, ray, t_max).is_some()
+    }
     /// [`Primitives::intersect`], adding the work done to `counts` (one primitive test by default; a
     /// primitive that is itself a structure, as objects of the two-level scene are, adds its traversal).
     fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {

@@ -1,9 +1,14 @@
-//! From description to runtime scene: loads mesh files (in parallel, each file once), takes every
-//! object to world space, and builds one acceleration structure over all bounded primitives
-//! (triangles, then spheres). Infinite planes stay outside the hierarchy and are tested one by one.
+//! From description to runtime scene, in two levels (Embree's scenes and instances): every mesh gets
+//! its own acceleration structure over its triangles in object space, and one top-level structure of
+//! the same kind indexes the scene's objects (meshes, spheres, instances) by their world bounds. An
+//! object with a transform is intersected by taking the ray into its object space (the direction is
+//! not normalised, so `t` is the same in both spaces); a `MeshInstance` reuses its base mesh's
+//! geometry and structure through its own transform, without copying either. Infinite planes have no
+//! bounds and are tested one by one after the hierarchy.
 //!
-//! Instances are expanded into copies of their base geometry for now; the two-level scene with shared
-//! geometry comes with the full set of structures.
+//! Mesh files are read once each, in parallel, and the per-mesh structures are built in parallel.
+//! Ties between objects go to the lower object index, and inside an object to the lower triangle
+//! index, so every structure kind gives the same hits as brute force at both levels.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -14,125 +19,173 @@ use rayon::prelude::*;
 
 use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
 use crate::accel::{self, Accel, AccelSpec, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
-use crate::geometry::{intersect_triangle, Plane, Sphere, TriangleMesh};
-use crate::math::{Aabb, Ray, Vec3};
+use crate::geometry::{Plane, Sphere, TriangleMesh};
+use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::{Error, Result};
 
-/// Every bounded primitive of a scene in world space: triangles first, then spheres.
-#[derive(Debug, Default)]
-pub struct ScenePrims {
-    /// All meshes' vertices, world space.
-    pub positions: Vec<Vec3>,
-    /// Per-vertex shading normals, world space (zero for vertices of flat-shaded meshes).
-    pub normals: Vec<Vec3>,
-    /// Triangles as indices into `positions`.
-    pub triangles: Vec<[u32; 3]>,
-    /// For each triangle, the object it belongs to.
-    pub triangle_object: Vec<u32>,
-    /// Spheres.
-    pub spheres: Vec<Sphere>,
-    /// For each sphere, the object it belongs to.
-    pub sphere_object: Vec<u32>,
+/// A mesh in object space under its own structure; shared by every object that shows it.
+pub struct MeshShape {
+    /// Triangles in object space; `normals` are set for smooth shading only.
+    pub mesh: TriangleMesh,
+    /// The structure over `mesh`'s triangles.
+    pub accel: Box<dyn Accel<TriangleMesh>>,
 }
 
-impl ScenePrims {
-    /// The corners of triangle `i`.
+/// What an object is made of.
+#[derive(Clone)]
+pub enum Shape {
+    /// A triangle mesh (possibly shared with instances).
+    Mesh(Arc<MeshShape>),
+    /// A sphere (its transform is its own).
+    Sphere(Sphere),
+}
+
+/// One bounded object of the runtime scene.
+#[derive(Clone)]
+pub struct SceneObject {
+    /// Geometry.
+    pub shape: Shape,
+    /// Object to world for meshes (spheres carry theirs); `None` for the identity.
+    pub transform: Option<Transform>,
+    /// World-space bounds.
+    pub bounds: Aabb,
+    /// Index into the description's objects.
+    pub object: u32,
+    /// Global index of the object's first primitive (for primitive ids across the whole scene).
+    pub first_prim: u32,
+}
+
+impl SceneObject {
+    /// The ray in object space (same `t` as in world space).
     #[inline]
-    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
-        let [a, b, c] = self.triangles[i];
-        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    fn local_ray(&self, ray: &Ray) -> Ray {
+        match &self.transform {
+            None => *ray,
+            Some(t) => Ray::new(t.inv.transform_point3(ray.origin), t.inv.transform_vector3(ray.dir))
+                .with_culling(ray.cull_backfaces),
+        }
     }
 }
 
-impl Primitives for ScenePrims {
+/// The scene's bounded objects, as primitives of the top-level structure.
+#[derive(Default)]
+pub struct SceneObjects {
+    /// Objects, in description order (planes excluded).
+    pub objects: Vec<SceneObject>,
+}
+
+impl Primitives for SceneObjects {
     fn len(&self) -> usize {
-        self.triangles.len() + self.spheres.len()
+        self.objects.len()
     }
     fn bounds(&self, i: usize) -> Aabb {
-        match i.checked_sub(self.triangles.len()) {
-            None => Aabb::from_points(self.triangle(i)),
-            Some(s) => self.spheres[s].bounds(),
-        }
+        self.objects[i].bounds
     }
     #[inline]
     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
-        match i.checked_sub(self.triangles.len()) {
-            None => {
-                let [a, b, c] = self.triangle(i);
-                intersect_triangle(ray, a, b, c, t_max).map(|h| PrimHit { t: h.t, u: h.b1, v: h.b2 })
-            }
-            Some(s) => self.spheres[s].intersect(ray, t_max).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+        let o = &self.objects[i];
+        match &o.shape {
+            Shape::Mesh(m) => m.accel.intersect(&m.mesh, &o.local_ray(ray), t_max).map(nested),
+            Shape::Sphere(s) => s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0)),
         }
     }
+    fn occludes(&self, i: usize, ray: &Ray, t_max: f32) -> bool {
+        let o = &self.objects[i];
+        match &o.shape {
+            Shape::Mesh(m) => m.accel.occluded(&m.mesh, &o.local_ray(ray), t_max),
+            Shape::Sphere(s) => s.intersect(ray, t_max).is_some(),
+        }
+    }
+    fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {
+        let o = &self.objects[i];
+        match &o.shape {
+            Shape::Mesh(m) => m.accel.intersect_counted(&m.mesh, &o.local_ray(ray), t_max, counts).map(nested),
+            Shape::Sphere(s) => {
+                counts.prims += 1;
+                s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
+            }
+        }
+    }
+}
+
+/// An object's hit as seen from the top level: the triangle becomes the sub-primitive.
+#[inline]
+fn nested(h: Hit) -> PrimHit {
+    PrimHit { t: h.t, u: h.u, v: h.v, sub: h.prim }
 }
 
 /// What a scene holds, for summaries and `arbor info`.
 #[derive(Debug, Clone, Default)]
 pub struct SceneCounts {
-    /// Triangles (after instancing).
+    /// Triangles as rendered (an instanced mesh counts once per instance).
     pub triangles: usize,
-    /// Degenerate triangles among them (zero area: never hit).
+    /// Triangles stored (each mesh once).
+    pub unique_triangles: usize,
+    /// Degenerate triangles among the stored ones (zero area: never hit).
     pub degenerate: usize,
     /// Spheres.
     pub spheres: usize,
     /// Infinite planes.
     pub planes: usize,
+    /// Objects under the top-level structure.
+    pub objects: usize,
     /// Time spent reading mesh files.
     pub mesh_load: Duration,
 }
 
-/// The geometry of a scene under its acceleration structure.
+/// The geometry of a scene under its two-level acceleration structure.
 pub struct SceneGeometry {
-    /// Bounded primitives.
-    pub prims: ScenePrims,
-    /// The structure over `prims`.
-    pub accel: Box<dyn Accel<ScenePrims>>,
-    /// Infinite planes and their objects.
+    /// The bounded objects.
+    pub objects: SceneObjects,
+    /// The top-level structure over `objects`.
+    pub top: Box<dyn Accel<SceneObjects>>,
+    /// Every distinct mesh with its structure.
+    pub meshes: Vec<Arc<MeshShape>>,
+    /// Infinite planes and their description objects.
     pub planes: Vec<(Plane, u32)>,
     /// Counts.
     pub counts: SceneCounts,
 }
 
 impl SceneGeometry {
-    /// The closest hit of `ray` in `(0, t_max)`. Plane hits get primitive indices after all bounded
-    /// primitives.
+    /// The closest hit of `ray` in `(0, t_max)`: `prim` is the object (planes come after the bounded
+    /// objects), `sub` the triangle inside a mesh.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         if !ray.is_valid() {
             return None;
         }
-        let mut best = self.accel.intersect(&self.prims, ray, t_max);
-        let base = self.prims.len() as u32;
-        for (k, (plane, _)) in self.planes.iter().enumerate() {
-            let limit = best.map_or(t_max, |h| h.t);
-            if let Some(t) = plane.intersect(ray, limit) {
-                best = Some(Hit { t, prim: base + k as u32, u: 0.0, v: 0.0 });
-            }
-        }
-        best
+        let best = self.top.intersect(&self.objects, ray, t_max);
+        self.intersect_planes(ray, t_max, best, None)
     }
 
-    /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested to `counts` (the
-    /// traversal-cost heatmap).
+    /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested at both levels to
+    /// `counts` (the traversal-cost heatmap).
     pub fn intersect_counted(&self, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
         if !ray.is_valid() {
             return None;
         }
-        let mut best = self.accel.intersect_counted(&self.prims, ray, t_max, counts);
-        let base = self.prims.len() as u32;
+        let best = self.top.intersect_counted(&self.objects, ray, t_max, counts);
+        self.intersect_planes(ray, t_max, best, Some(counts))
+    }
+
+    fn intersect_planes(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut best: Option<Hit>,
+        mut counts: Option<&mut TraversalCounts>,
+    ) -> Option<Hit> {
+        let base = self.objects.len() as u32;
         for (k, (plane, _)) in self.planes.iter().enumerate() {
-            counts.prims += 1;
-            let limit = best.map_or(t_max, |h| h.t);
-            if let Some(t) = plane.intersect(ray, limit) {
-                best = Some(Hit { t, prim: base + k as u32, u: 0.0, v: 0.0 });
+            if let Some(c) = counts.as_deref_mut() {
+                c.prims += 1;
+            }
+            if let Some(t) = plane.intersect(ray, best.map_or(t_max, |h| h.t)) {
+                best = Some(Hit { t, prim: base + k as u32, u: 0.0, v: 0.0, sub: 0 });
             }
         }
         best
-    }
-
-    /// The world-space boxes of the structure's nodes at `depth` (the boxes debug view).
-    pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
-        self.accel.boxes_at_depth(depth)
     }
 
     /// Whether anything lies on `ray` in `(0, t_max)`.
@@ -140,89 +193,203 @@ impl SceneGeometry {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         ray.is_valid()
             && (self.planes.iter().any(|(p, _)| p.intersect(ray, t_max).is_some())
-                || self.accel.occluded(&self.prims, ray, t_max))
+                || self.top.occluded(&self.objects, ray, t_max))
     }
 
-    /// The acceleration structure's statistics.
+    /// A scene-wide id of the primitive hit (triangle, sphere or plane), the same for every structure.
+    pub fn global_prim_id(&self, hit: &Hit) -> u32 {
+        match self.objects.objects.get(hit.prim as usize) {
+            Some(o) => o.first_prim + hit.sub,
+            None => {
+                let bounded = self.objects.objects.last().map_or(0, |o| o.first_prim + prim_count(&o.shape));
+                bounded + (hit.prim - self.objects.len() as u32)
+            }
+        }
+    }
+
+    /// The world-space boxes of the nodes at `depth` of every mesh's structure, and of the top-level
+    /// structure's when the scene has more than one object (the boxes debug view).
+    pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+        let mut out = Vec::new();
+        if self.objects.len() > 1 {
+            out.extend(self.top.boxes_at_depth(depth));
+        }
+        for o in &self.objects.objects {
+            if let Shape::Mesh(m) = &o.shape {
+                let boxes = m.accel.boxes_at_depth(depth);
+                out.extend(boxes.into_iter().map(|b| world_box(&b, o.transform.as_ref())));
+            }
+        }
+        out
+    }
+
+    /// Statistics of the structures together: the top level plus every distinct mesh's structure
+    /// (counts and bytes summed; depths through both levels; the SAH cost is the top level's plus each
+    /// mesh's weighted by the share of the scene's area its object covers, an estimate).
     pub fn accel_stats(&self) -> AccelStats {
-        self.accel.stats()
+        let top = self.top.stats();
+        let mut s = AccelStats { primitives: 0, ..top.clone() };
+        let (mut leaf_prims, mut depth_sum, mut refs) = (0.0, 0.0, 0.0);
+        let scene_area = self.bounds().area().max(f32::MIN_POSITIVE) as f64;
+        let mut mesh_max_depth = 0;
+        for m in &self.meshes {
+            let ms = m.accel.stats();
+            s.primitives += ms.primitives;
+            s.nodes += ms.nodes;
+            s.leaves += ms.leaves;
+            s.bytes += ms.bytes;
+            s.build_time += ms.build_time;
+            mesh_max_depth = mesh_max_depth.max(ms.max_depth);
+            leaf_prims += ms.mean_leaf_prims * ms.leaves as f64;
+            depth_sum += ms.mean_depth * ms.leaves as f64;
+            refs += ms.refs_per_prim * ms.primitives as f64;
+            s.sah_cost += ms.sah_cost * (m.accel.bounds().area() as f64 / scene_area).min(1.0);
+        }
+        s.primitives += self.counts.spheres;
+        refs += self.counts.spheres as f64;
+        s.max_depth = top.max_depth + mesh_max_depth;
+        let mesh_leaves = (s.leaves - top.leaves) as f64;
+        if mesh_leaves > 0.0 {
+            s.mean_leaf_prims = leaf_prims / mesh_leaves;
+            s.mean_depth = top.mean_depth + depth_sum / mesh_leaves;
+        }
+        s.refs_per_prim = if s.primitives > 0 { refs / s.primitives as f64 } else { 0.0 };
+        s
     }
 
-    /// Bounds of the bounded primitives.
+    /// Bounds of the bounded objects.
     pub fn bounds(&self) -> Aabb {
-        self.accel.bounds()
+        self.top.bounds()
     }
 }
 
-/// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes.
+fn prim_count(shape: &Shape) -> u32 {
+    match shape {
+        Shape::Mesh(m) => m.mesh.len() as u32,
+        Shape::Sphere(_) => 1,
+    }
+}
+
+/// The world box of an object-space box.
+fn world_box(b: &Aabb, t: Option<&Transform>) -> Aabb {
+    let Some(t) = t else { return *b };
+    (0..8).fold(Aabb::EMPTY, |acc, i| {
+        let corner = Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        );
+        acc.grow(t.point(corner))
+    })
+}
+
+/// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes, at both
+/// levels.
 pub fn build_geometry(desc: &SceneDesc, spec: &AccelSpec) -> Result<SceneGeometry> {
+    spec.check().map_err(Error::Invalid)?;
     let start = Instant::now();
-    let meshes = load_mesh_files(desc)?;
+    let files = load_mesh_files(desc)?;
     let mesh_load = start.elapsed();
 
-    let mut prims = ScenePrims::default();
+    // One shape per mesh object, built in parallel; instances point at their base's.
+    let mesh_objects: Vec<usize> =
+        (0..desc.objects.len()).filter(|&i| matches!(desc.objects[i].shape, ShapeDesc::Mesh { .. })).collect();
+    let shapes: Vec<Arc<MeshShape>> = mesh_objects
+        .par_iter()
+        .map(|&i| {
+            let ShapeDesc::Mesh { source, smooth } = &desc.objects[i].shape else { unreachable!() };
+            let mesh = match source {
+                MeshSource::Inline(m) => m.as_ref(),
+                MeshSource::File(path) => files[path].as_ref(),
+            };
+            Arc::new(mesh_shape(mesh, *smooth, spec))
+        })
+        .collect();
+    let shape_of: HashMap<usize, Arc<MeshShape>> = mesh_objects.iter().copied().zip(shapes.iter().cloned()).collect();
+
+    let mut objects = SceneObjects::default();
     let mut planes = Vec::new();
+    let mut counts = SceneCounts { mesh_load, ..SceneCounts::default() };
+    let mut first_prim = 0u32;
     for (index, object) in desc.objects.iter().enumerate() {
-        let (shape_object, transform) = match object.shape {
-            ShapeDesc::Instance { base } => (resolve_instance(desc, index, base)?, object.transform),
-            _ => (object, object.transform),
+        let shape_index = match object.shape {
+            ShapeDesc::Instance { base } => resolve_instance(desc, index, base)?,
+            _ => index,
         };
-        let id = index as u32;
-        match &shape_object.shape {
-            ShapeDesc::Mesh { source, smooth } => {
-                let mesh = match source {
-                    MeshSource::Inline(m) => m.clone(),
-                    MeshSource::File(path) => meshes[path].clone(),
-                };
-                add_mesh(&mut prims, &mesh.transformed(&transform), *smooth, id);
-            }
+        let transform = (!object.transform.is_identity()).then_some(object.transform);
+        let shape = match &desc.objects[shape_index].shape {
+            ShapeDesc::Mesh { .. } => Shape::Mesh(shape_of[&shape_index].clone()),
             ShapeDesc::Sphere { center, radius } => {
-                prims.spheres.push(Sphere { center: *center, radius: *radius, transform });
-                prims.sphere_object.push(id);
+                Shape::Sphere(Sphere { center: *center, radius: *radius, transform: object.transform })
             }
             ShapeDesc::Plane { point, normal } => {
-                let point = transform.point(*point);
-                let normal = transform.normal(*normal).normalize();
-                planes.push((Plane { point, normal }, id));
+                let point = object.transform.point(*point);
+                let normal = object.transform.normal(*normal).normalize();
+                planes.push((Plane { point, normal }, index as u32));
+                continue;
             }
             ShapeDesc::Instance { .. } => unreachable!("resolve_instance never returns an instance"),
+        };
+        let bounds = match &shape {
+            Shape::Mesh(m) => world_box(&m.accel.bounds(), transform.as_ref()),
+            Shape::Sphere(s) => s.bounds(),
+        };
+        match &shape {
+            Shape::Mesh(m) => counts.triangles += m.mesh.len(),
+            Shape::Sphere(_) => counts.spheres += 1,
         }
+        let object = SceneObject {
+            transform: if matches!(shape, Shape::Sphere(_)) { None } else { transform },
+            shape,
+            bounds,
+            object: index as u32,
+            first_prim,
+        };
+        first_prim += prim_count(&object.shape);
+        objects.objects.push(object);
     }
-    let degenerate = (0..prims.triangles.len())
-        .filter(|&i| {
-            let [a, b, c] = prims.triangle(i);
-            (b - a).cross(c - a).length_squared() == 0.0
-        })
-        .count();
-    let counts = SceneCounts {
-        triangles: prims.triangles.len(),
-        degenerate,
-        spheres: prims.spheres.len(),
-        planes: planes.len(),
-        mesh_load,
+    counts.unique_triangles = shapes.iter().map(|s| s.mesh.len()).sum();
+    counts.degenerate = shapes.iter().map(|s| s.mesh.check().degenerate).sum();
+    counts.planes = planes.len();
+    counts.objects = objects.len();
+    let top = accel::build_with(spec, &objects).map_err(Error::Invalid)?;
+    Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
+}
+
+/// A mesh ready for rendering: smooth meshes get vertex normals (from the file, or averaged from the
+/// faces), flat ones none (the shader then uses the face normal).
+fn mesh_shape(mesh: &TriangleMesh, smooth: bool, spec: &AccelSpec) -> MeshShape {
+    let mut mesh = TriangleMesh { uvs: None, ..mesh.clone() };
+    if smooth {
+        match &mut mesh.normals {
+            Some(n) => n.iter_mut().for_each(|v| *v = v.normalize_or_zero()),
+            None => mesh.compute_vertex_normals(),
+        }
+    } else {
+        mesh.normals = None;
+    }
+    let accel = match accel::build_with(spec, &mesh) {
+        Ok(a) => a,
+        Err(e) => unreachable!("parameters were checked before building: {e}"),
     };
-    let accel = accel::build_with(spec, &prims).map_err(Error::Invalid)?;
-    Ok(SceneGeometry { prims, accel, planes, counts })
+    MeshShape { mesh, accel }
 }
 
 /// The object an instance draws its geometry from (following chains of instances).
-fn resolve_instance(desc: &SceneDesc, index: usize, mut base: usize) -> Result<&ObjectDesc> {
+fn resolve_instance(desc: &SceneDesc, index: usize, mut base: usize) -> Result<usize> {
+    let me = &desc.objects[index];
     for _ in 0..desc.objects.len() {
-        let object = desc.objects.get(base).ok_or_else(|| {
-            Error::input(
-                desc.objects[index].loc.clone(),
-                format!("{}: base object does not exist", desc.objects[index].name),
-            )
-        })?;
+        let object = desc
+            .objects
+            .get(base)
+            .ok_or_else(|| Error::input(me.loc.clone(), format!("{}: base object does not exist", me.name)))?;
         match object.shape {
             ShapeDesc::Instance { base: next } => base = next,
-            _ => return Ok(object),
+            ShapeDesc::Mesh { .. } => return Ok(base),
+            _ => return Err(Error::input(me.loc.clone(), format!("{}: base {} is not a mesh", me.name, object.name))),
         }
     }
-    Err(Error::input(
-        desc.objects[index].loc.clone(),
-        format!("{}: instances refer to each other in a cycle", desc.objects[index].name),
-    ))
+    Err(Error::input(me.loc.clone(), format!("{}: instances refer to each other in a cycle", me.name)))
 }
 
 /// Reads every distinct mesh file once, in parallel. A failure names the object that asked for the file.
@@ -248,26 +415,4 @@ fn load_mesh_files(desc: &SceneDesc) -> Result<HashMap<PathBuf, Arc<TriangleMesh
             Ok(((*path).clone(), Arc::new(mesh)))
         })
         .collect()
-}
-
-/// Appends a world-space mesh. Smooth meshes get vertex normals (from the file, or averaged from the
-/// faces); flat ones get zero normals, which tells the shader to use the face normal.
-fn add_mesh(prims: &mut ScenePrims, mesh: &TriangleMesh, smooth: bool, object: u32) {
-    let offset = prims.positions.len() as u32;
-    prims.positions.extend_from_slice(&mesh.positions);
-    if smooth {
-        let normals = match &mesh.normals {
-            Some(n) => n.iter().map(|n| n.normalize_or_zero()).collect(),
-            None => {
-                let mut m = mesh.clone();
-                m.compute_vertex_normals();
-                m.normals.unwrap_or_default()
-            }
-        };
-        prims.normals.extend(normals);
-    } else {
-        prims.normals.extend(std::iter::repeat(Vec3::ZERO).take(mesh.positions.len()));
-    }
-    prims.triangles.extend(mesh.indices.iter().map(|t| t.map(|i| i + offset)));
-    prims.triangle_object.extend(std::iter::repeat(object).take(mesh.indices.len()));
 }

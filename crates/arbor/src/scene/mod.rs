@@ -15,7 +15,7 @@ mod xml;
 
 use std::path::Path;
 
-pub use build::{build_geometry, SceneCounts, SceneGeometry, ScenePrims};
+pub use build::{build_geometry, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
 pub use desc::*;
 pub use runtime::{Scene, Surface};
 

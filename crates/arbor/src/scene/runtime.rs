@@ -4,9 +4,10 @@
 
 use std::time::{Duration, Instant};
 
-use super::build::{build_geometry, SceneGeometry};
+use super::build::{build_geometry, SceneGeometry, Shape};
 use super::desc::{MaterialDesc, SceneDesc};
 use crate::accel::{AccelSpec, Hit};
+use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::math::{Ray, Vec3};
 use crate::{Error, Location, Result};
@@ -69,31 +70,51 @@ impl Scene {
 
     /// Shading data for `hit`, found on `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let prims = &self.geometry.prims;
+        let g = &self.geometry;
         let p = ray.at(hit.t);
-        let i = hit.prim as usize;
-        let n_tris = prims.triangles.len();
-        let n_bounded = n_tris + prims.spheres.len();
-        let (ng, ns, object) = if i < n_tris {
-            let [a, b, c] = prims.triangle(i);
-            let ng = (b - a).cross(c - a).normalize_or_zero();
-            let [ia, ib, ic] = prims.triangles[i];
-            let (na, nb, nc) = (prims.normals[ia as usize], prims.normals[ib as usize], prims.normals[ic as usize]);
-            let ns = if na == Vec3::ZERO || nb == Vec3::ZERO || nc == Vec3::ZERO {
-                ng
-            } else {
-                ((1.0 - hit.u - hit.v) * na + hit.u * nb + hit.v * nc).normalize_or(ng)
-            };
-            (ng, ns, prims.triangle_object[i])
-        } else if i < n_bounded {
-            let s = i - n_tris;
-            let n = prims.spheres[s].normal_at(p);
-            (n, n, prims.sphere_object[s])
-        } else {
-            let (plane, object) = &self.geometry.planes[i - n_bounded];
-            (plane.normal, plane.normal, *object)
+        let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
+            Some(o) => {
+                let (ng, ns) = match &o.shape {
+                    Shape::Mesh(m) => {
+                        let (ng, ns) = triangle_normals(&m.mesh, hit);
+                        match &o.transform {
+                            None => (ng, ns),
+                            Some(t) => {
+                                let nm = t.normal_matrix();
+                                let ng = (nm * ng).normalize_or_zero();
+                                (ng, (nm * ns).normalize_or(ng))
+                            }
+                        }
+                    }
+                    Shape::Sphere(s) => {
+                        let n = s.normal_at(p);
+                        (n, n)
+                    }
+                };
+                (ng, ns, o.object)
+            }
+            None => {
+                let (plane, object) = &g.planes[hit.prim as usize - g.objects.objects.len()];
+                (plane.normal, plane.normal, *object)
+            }
         };
-        let object_desc = &self.desc.objects[object as usize];
-        Surface { p, ng, ns, object, material: object_desc.material }
+        Surface { p, ng, ns, object, material: self.desc.objects[object as usize].material }
     }
+}
+
+/// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal
+/// interpolates the vertex normals of smooth meshes.
+fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
+    let i = hit.sub as usize;
+    let [a, b, c] = mesh.triangle(i);
+    let ng = (b - a).cross(c - a).normalize_or_zero();
+    let ns = match &mesh.normals {
+        Some(n) => {
+            let [ia, ib, ic] = mesh.indices[i];
+            let interpolated = (1.0 - hit.u - hit.v) * n[ia as usize] + hit.u * n[ib as usize] + hit.v * n[ic as usize];
+            interpolated.normalize_or(ng)
+        }
+        None => ng,
+    };
+    (ng, ns)
 }

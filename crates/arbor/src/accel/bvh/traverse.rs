@@ -175,7 +175,7 @@ pub(super) fn occluded<P: Primitives + ?Sized>(
             if node.is_leaf() {
                 let first = node.offset as usize;
                 let leaf = &indices[first..first + node.count as usize];
-                if leaf.iter().any(|&p| prims.intersect(p as usize, ray, t_max).is_some()) {
+                if leaf.iter().any(|&p| prims.occludes(p as usize, ray, t_max)) {
                     return true;
                 }
             } else {
