@@ -22,6 +22,7 @@
 
 mod bottom_up;
 mod build;
+mod median;
 mod traverse;
 mod validate;
 
@@ -170,10 +171,11 @@ impl Bvh {
         Bvh::from_flat(nodes, prim_indices, live, "bvh-sah", start)
     }
 
-    /// PLACEHOLDER until the median builder lands: the SAH build.
+    /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
+    /// `median.rs`); of `params`, only [`BvhParams::max_leaf_prims`] applies.
     pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
+        let (nodes, prim_indices, live) = median::build_median(prims, &params.sanitized());
         Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
     }
 
