@@ -28,7 +28,7 @@ mod validate;
 
 use std::time::{Duration, Instant};
 
-pub use bottom_up::BottomUpParams;
+pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 
 use super::params::{parse_value, unknown_key};
 use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
@@ -179,10 +179,10 @@ impl Bvh {
         Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
     }
 
-    /// PLACEHOLDER until the bottom-up builder lands: the SAH build.
-    pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, _params: &BottomUpParams) -> Bvh {
+    /// Builds a BVH over `prims` bottom-up, by the exact greedy method or PLOC (see `bottom_up/`).
+    pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = build::build_sah(prims, &BvhParams::default());
+        let (nodes, prim_indices, live) = bottom_up::build(prims, params);
         Bvh::from_flat(nodes, prim_indices, live, "bvh-bottom-up", start)
     }
 
