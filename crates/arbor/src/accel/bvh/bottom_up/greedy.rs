@@ -9,7 +9,7 @@
 //!
 //! Ties: pairs are ordered by (cost, distance between the slots, lower slot), a total order, so the
 //! least pair is unique and the tree deterministic. Preferring nearby slots (input order is usually
-//! spatially coherent) also keeps ties from pointing every cluster at one partner, which made
+//! spatially coherent) also keeps ties from pointing every cluster at one partner, which would make
 //! duplicate primitives cost O(n³).
 //!
 //! Cost: O(n) memory. Each merge scans the clusters once (O(n)) plus O(n) per cluster that lost its

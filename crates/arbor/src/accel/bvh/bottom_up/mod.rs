@@ -35,7 +35,8 @@ use crate::math::Aabb;
 pub enum BottomUpMethod {
     /// [`BottomUpMethod::Greedy`] up to [`BottomUpParams::greedy_max`] primitives, [`BottomUpMethod::Ploc`] above.
     Auto,
-    /// The exact greedy method: O(n²) time in practice, O(n³) worst case.
+    /// The exact greedy method: O(n²) time in practice, O(n³) worst case, whatever the input size
+    /// (`greedy-max` applies to `auto` only).
     Greedy,
     /// PLOC (Meister and Bittner 2018): O(n log n).
     Ploc,
