@@ -621,3 +621,74 @@ proptest! {
         check("lattice soup", &mesh, &probes);
     }
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Builder variants that the defaults above never reach: `build` uses each kind's default parameters,
+// and the default bottom-up build picks the greedy method (area cost) for every set under 2,000
+// primitives, so PLOC, the other merge costs and one-primitive leaves are checked here, on the
+// adversarial families.
+
+/// Non-default parameter sets, as `--accel-param` would give them.
+const VARIANTS: &[(AccelKind, &[&str])] = &[
+    (AccelKind::BvhBottomUp, &["method=ploc"]),
+    (AccelKind::BvhBottomUp, &["method=ploc", "radius=1", "leaf=1"]),
+    (AccelKind::BvhBottomUp, &["method=greedy", "cost=distance"]),
+    (AccelKind::BvhBottomUp, &["method=greedy", "cost=volume", "leaf=1"]),
+    (AccelKind::BvhMedian, &["leaf=1"]),
+];
+const VARIANT_RAYS: usize = 10_000;
+
+/// [`check`] for every entry of [`VARIANTS`] (built with `build_with`, validated in debug builds).
+fn check_variants(case: &str, tris: &[[Vec3; 3]], rng: &mut Rng) {
+    use arbor::accel::{build_with, AccelSpec};
+    let mesh = mesh_of(tris);
+    let probes = Targets::of(&mesh, &tris.concat()).probes(rng, VARIANT_RAYS);
+    let brute = build(AccelKind::Brute, &mesh);
+    for &(kind, params) in VARIANTS {
+        let spec = AccelSpec::new(kind).with_params(params.iter().copied()).unwrap();
+        let accel = build_with(&spec, &mesh).unwrap();
+        for p in &probes {
+            let (got, want) = (accel.intersect(&mesh, &p.ray, p.t_max), brute.intersect(&mesh, &p.ray, p.t_max));
+            assert!(same_hit(got, want), "{kind} {params:?} on {case}: {p:?} hit {got:?}, brute force {want:?}");
+            let (got, want) = (accel.occluded(&mesh, &p.ray, p.t_max), brute.occluded(&mesh, &p.ray, p.t_max));
+            assert_eq!(got, want, "{kind} {params:?} on {case}: occluded {p:?}");
+        }
+    }
+}
+
+#[test]
+fn bvh_variants_match_brute_force_on_adversarial_sets() {
+    let mut rng = Rng::new(1100);
+    let soup = random_soup(&mut rng, 500, 20.0, 2.0);
+    check_variants("soup", &soup, &mut rng);
+    let offset: Vec<_> = soup.iter().map(|t| t.map(|p| p + Vec3::splat(1e5))).collect();
+    check_variants("soup offset by 1e5", &offset, &mut rng);
+    check_variants("grid", &grid(6, 4), &mut rng);
+    check_variants("closed cube", &closed_cube(8), &mut rng);
+    // Duplicates at random indices and coplanar overlaps: ties at equal t across leaves.
+    let mut dups = random_soup(&mut rng, 60, 6.0, 2.0);
+    for _ in 0..200 {
+        let t = rng.pick(&dups);
+        dups.insert(rng.below(dups.len() + 1), t);
+    }
+    dups.extend((0..80).map(|_| {
+        let c = rng.vec3() * 6.0;
+        [0; 3].map(|_| (c + (rng.vec3() - 0.5) * 3.0).with_z(1.0))
+    }));
+    check_variants("duplicates", &dups, &mut rng);
+    // Points, lines, non-finite and huge triangles among good ones.
+    let mut bad = random_soup(&mut rng, 100, 8.0, 2.0);
+    for _ in 0..150 {
+        let (a, b) = (rng.vec3() * 8.0, rng.vec3() * 8.0);
+        let nan = Vec3::new(f32::NAN, a.y, a.z);
+        bad.push(rng.pick(&[[a; 3], [a, 0.5 * (a + b), b], [a, b, nan], [a, Vec3::splat(-1e30), Vec3::splat(1e30)]]));
+    }
+    check_variants("degenerates", &bad, &mut rng);
+    // Gaps growing fourfold: clustering builds one chain as long as the input, which the builder must
+    // rebalance to fit the traversal stack.
+    let chain: Vec<_> = (0..64)
+        .flat_map(|i| [1.0f32, -1.0].map(|s| s * 4f32.powi(i)))
+        .map(|x| [Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)])
+        .collect();
+    check_variants("chain", &chain, &mut rng);
+}

@@ -24,18 +24,21 @@ use crate::accel::Primitives;
 use crate::math::{Aabb, Vec3};
 
 /// Nodes with at least this many primitives build their two children in parallel.
-const PARALLEL_THRESHOLD: usize = 4096;
+pub(super) const PARALLEL_THRESHOLD: usize = 4096;
 
 /// What the builder knows about one primitive.
 #[derive(Debug, Clone, Copy)]
-struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3,
-    index: u32,
+pub(super) struct BuildPrim {
+    /// Bounds, finite and not empty.
+    pub bounds: Aabb,
+    /// The point the builders sort and split by.
+    pub centroid: Vec3,
+    /// The primitive's index in the input.
+    pub index: u32,
 }
 
-/// The temporary tree.
-enum BuildNode {
+/// The temporary tree, shared by every builder: leaves refer to ranges of the reordered primitives.
+pub(super) enum BuildNode {
     Leaf { bounds: Aabb, first: u32, count: u16 },
     Inner { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
 }
@@ -70,20 +73,32 @@ impl Binner {
 
 /// Builds the flat node array, the reordered primitive indices and the number of primitives in the tree.
 pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> (Vec<Node>, Vec<u32>, usize) {
+    let (mut live, dead) = split_live(prims);
+    let root = (!live.is_empty()).then(|| build_node(&mut live, 0, 0, params));
+    finish(root.as_ref(), &live, &dead)
+}
+
+/// The builder's view of every primitive that can be hit, in index order, and the indices of those
+/// that cannot (empty or non-finite bounds), which every builder keeps out of the tree.
+pub(super) fn split_live<P: Primitives + ?Sized>(prims: &P) -> (Vec<BuildPrim>, Vec<u32>) {
     assert!(prims.len() <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
     let all: Vec<(u32, Option<BuildPrim>)> =
         (0..prims.len()).into_par_iter().map(|i| (i as u32, build_prim(prims, i))).collect();
-    let mut live: Vec<BuildPrim> = all.iter().filter_map(|(_, p)| *p).collect();
-    let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i);
+    let live = all.iter().filter_map(|(_, p)| *p).collect();
+    let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i).collect();
+    (live, dead)
+}
+
+/// The flat array of `root` (whose leaves refer to ranges of `live`, in that order), the index array
+/// (`live`, then `dead`) and the number of live primitives: what [`super::Bvh::from_flat`] takes.
+pub(super) fn finish(root: Option<&BuildNode>, live: &[BuildPrim], dead: &[u32]) -> (Vec<Node>, Vec<u32>, usize) {
     let mut nodes = Vec::new();
-    if !live.is_empty() {
-        let root = build_node(&mut live, 0, 0, params);
-        nodes.reserve(count_nodes(&root));
-        flatten(&root, &mut nodes);
+    if let Some(root) = root {
+        nodes.reserve(count_nodes(root));
+        flatten(root, &mut nodes);
     }
-    let n_live = live.len();
-    let indices = live.iter().map(|p| p.index).chain(dead).collect();
-    (nodes, indices, n_live)
+    let indices = live.iter().map(|p| p.index).chain(dead.iter().copied()).collect();
+    (nodes, indices, live.len())
 }
 
 /// The builder's view of primitive `i`, or `None` when its bounds are empty or not finite: such a
@@ -119,7 +134,7 @@ fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &Bvh
 }
 
 /// A leaf over `count` primitives at `offset`.
-fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode {
+pub(super) fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode {
     debug_assert!((1..=LEAF_HARD_MAX).contains(&count));
     BuildNode::Leaf { bounds, first: offset as u32, count: count as u16 }
 }

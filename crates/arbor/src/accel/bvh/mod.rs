@@ -1,7 +1,11 @@
-//! Bounding volume hierarchy: a binary tree of axis-aligned boxes over primitive indices, built top-down
-//! with the binned surface area heuristic (Wald 2007, "On fast construction of SAH-based bounding volume
-//! hierarchies"; pbrt-v4's `BVHAggregate`) and stored as one flat array of 32-byte nodes (pbrt's
-//! `LinearBVHNode`).
+//! Bounding volume hierarchy: a binary tree of axis-aligned boxes over primitive indices, stored as one
+//! flat array of 32-byte nodes (pbrt's `LinearBVHNode`). Three builders write that array, and share
+//! the traversal (`traverse.rs`) and the checks (`validate.rs`):
+//! - [`Bvh::build_sah`] (`build.rs`): top-down, binned surface area heuristic (Wald 2007, "On fast
+//!   construction of SAH-based bounding volume hierarchies"; pbrt-v4's `BVHAggregate`);
+//! - [`Bvh::build_median`] (`median.rs`): top-down, split at the median centroid on the longest axis;
+//! - [`Bvh::build_bottom_up`] (`bottom_up/`): agglomerative, the exact greedy method for small inputs
+//!   and PLOC (Meister and Bittner 2018) for any size.
 //!
 //! Layout: nodes are written depth first, so an inner node's first child is the next node and only the
 //! second child's index is stored. Leaves hold a range of [`Bvh::prim_indices`], the primitive indices
@@ -16,18 +20,20 @@
 //! - leaves hold at most [`LEAF_HARD_MAX`] primitives and the tree is at most [`MAX_DEPTH`] deep, so the
 //!   fixed-size traversal stack cannot overflow.
 //!
-//! Cost: the build is O(n log n) (one binning pass per level), with the two halves of large nodes built
-//! in parallel; the result does not depend on the thread count. A query is O(log n) on well-distributed
-//! scenes; memory is 32 bytes per node (about `2n / leaf size` nodes) plus 4 bytes per primitive.
+//! Cost: the SAH and median builds are O(n log n) (one binning or selection pass per level), with the
+//! two halves of large nodes built in parallel; PLOC is O(n log n) in practice, the greedy method
+//! O(n²) (see their modules). No result depends on the thread count. A query is O(log n) on
+//! well-distributed scenes; memory is 32 bytes per node (about `2n / leaf size` nodes) plus 4 bytes per primitive.
 
 mod bottom_up;
 mod build;
+mod median;
 mod traverse;
 mod validate;
 
 use std::time::{Duration, Instant};
 
-pub use bottom_up::BottomUpParams;
+pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 
 use super::params::{parse_value, unknown_key};
 use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
@@ -38,7 +44,8 @@ use crate::math::{Aabb, Ray, Vec3};
 pub const LEAF_HARD_MAX: usize = 64;
 
 /// Every node's depth (root at depth 0) is below this, which sizes the traversal stack. From depth 64
-/// on the builder stops looking for SAH splits and halves index ranges, which adds at most 32 levels.
+/// on, the SAH builder stops looking for SAH splits and halves index ranges, and the bottom-up builder
+/// rebuilds subtrees that are still too deep with the median split; either adds at most 32 levels.
 pub const MAX_DEPTH: usize = MAX_SAH_DEPTH + 33;
 
 /// Depth after which SAH splits are no longer tried. Binned splits shrink the centroid extent by at
@@ -91,11 +98,11 @@ impl Node {
     }
 }
 
-/// Build knobs of the SAH BVH.
+/// Build knobs of the SAH BVH; the median build uses only [`BvhParams::max_leaf_prims`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BvhParams {
     /// A node with more primitives is always split; one with at most this many becomes a leaf when
-    /// splitting does not lower the SAH cost. Clamped to `1..=LEAF_HARD_MAX`.
+    /// splitting does not lower the SAH cost (median build: always). Clamped to `1..=LEAF_HARD_MAX`.
     pub max_leaf_prims: usize,
     /// Number of SAH bins along the split axis. Clamped to `2..=MAX_BINS`.
     pub bins: usize,
@@ -170,17 +177,18 @@ impl Bvh {
         Bvh::from_flat(nodes, prim_indices, live, "bvh-sah", start)
     }
 
-    /// PLACEHOLDER until the median builder lands: the SAH build.
+    /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
+    /// `median.rs`); of `params`, only [`BvhParams::max_leaf_prims`] applies.
     pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
+        let (nodes, prim_indices, live) = median::build_median(prims, &params.sanitized());
         Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
     }
 
-    /// PLACEHOLDER until the bottom-up builder lands: the SAH build.
-    pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, _params: &BottomUpParams) -> Bvh {
+    /// Builds a BVH over `prims` bottom-up, by the exact greedy method or PLOC (see `bottom_up/`).
+    pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = build::build_sah(prims, &BvhParams::default());
+        let (nodes, prim_indices, live) = bottom_up::build(prims, params);
         Bvh::from_flat(nodes, prim_indices, live, "bvh-bottom-up", start)
     }
 

@@ -6,21 +6,21 @@ use crate::accel::{build, AccelKind, BruteForce};
 use crate::geometry::TriangleMesh;
 
 /// xorshift64*: small, seeded, good enough to scatter triangles.
-struct Rng(u64);
+pub(super) struct Rng(pub u64);
 
 impl Rng {
-    fn f32(&mut self) -> f32 {
+    pub(super) fn f32(&mut self) -> f32 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
     }
-    fn vec3(&mut self) -> Vec3 {
+    pub(super) fn vec3(&mut self) -> Vec3 {
         Vec3::new(self.f32(), self.f32(), self.f32())
     }
 }
 
-fn soup(n: usize, seed: u64) -> TriangleMesh {
+pub(super) fn soup(n: usize, seed: u64) -> TriangleMesh {
     let mut rng = Rng(seed);
     let mut mesh = TriangleMesh::default();
     for i in 0..n {
@@ -34,12 +34,12 @@ fn soup(n: usize, seed: u64) -> TriangleMesh {
     mesh
 }
 
-fn rays(n: usize, seed: u64) -> Vec<Ray> {
+pub(super) fn rays(n: usize, seed: u64) -> Vec<Ray> {
     let mut rng = Rng(seed);
     (0..n).map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5)).collect()
 }
 
-fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
+pub(super) fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
     let brute = BruteForce::build(mesh);
     for ray in rays {
         let (a, b) = (bvh.intersect(mesh, ray, f32::INFINITY), brute.intersect(mesh, ray, f32::INFINITY));
@@ -226,4 +226,92 @@ fn bvh_factory_builds_a_bvh() {
     let mesh = soup(100, 5);
     let accel = build(AccelKind::BvhSah, &mesh);
     assert_eq!(accel.stats().kind, "bvh-sah");
+}
+
+/// Runs `f` on a pool of `threads` threads.
+pub(super) fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+}
+
+/// The shared Stanford bunny (`../shared/meshes` beside the checkout), or `None` after saying why; under
+/// CI (`CI=true`) an absent mesh is a failure.
+pub(super) fn bunny() -> Option<TriangleMesh> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/stanford-bunny.obj");
+    if !path.is_file() {
+        assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "{} is required under CI", path.display());
+        eprintln!("SKIPPED: {} not found", path.display());
+        return None;
+    }
+    Some(crate::mesh_io::load_mesh(&path).unwrap())
+}
+
+/// SAH cost of `bvh` (stats' convention: traversal and intersection cost 1).
+pub(super) fn sah(bvh: &Bvh) -> f64 {
+    Accel::<TriangleMesh>::stats(bvh).sah_cost
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Median split
+
+#[test]
+fn median_matches_brute_force_on_small_soup() {
+    for (n, leaf) in [(1, 8), (2, 1), (200, 8), (300, 1), (500, 64)] {
+        let mesh = soup(n, n as u64 + 40);
+        let bvh = Bvh::build_median(&mesh, &BvhParams { max_leaf_prims: leaf, ..BvhParams::default() });
+        bvh.validate(&mesh).unwrap();
+        assert_matches_brute(&mesh, &bvh, &rays(2000, 3));
+    }
+}
+
+#[test]
+fn median_tree_is_balanced_with_bounded_leaves() {
+    let mesh = soup(10_000, 41);
+    let bvh = Bvh::build_median(&mesh, &BvhParams { max_leaf_prims: 5, ..BvhParams::default() });
+    let s = Accel::<TriangleMesh>::stats(&bvh);
+    assert_eq!(s.kind, "bvh-median");
+    // 10,000 halved until at most 5: every leaf at depth 11 (10,000 / 2^11 is 4.9), 3 to 5 primitives.
+    assert_eq!((s.max_depth, s.mean_depth), (11, 11.0), "{s:?}");
+    assert!(bvh.nodes().iter().filter(|n| n.is_leaf()).all(|n| (3..=5).contains(&n.count)));
+}
+
+#[test]
+fn median_splits_coincident_centroids_by_index() {
+    // 1,000 copies of one triangle: selection by (centroid, index) still halves them.
+    let mut mesh = soup(1, 1);
+    mesh.indices = vec![[0, 1, 2]; 1000];
+    let bvh = Bvh::build_median(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    assert_eq!(Accel::<TriangleMesh>::stats(&bvh).max_depth, 7);
+    assert_matches_brute(&mesh, &bvh, &rays(500, 2));
+}
+
+#[test]
+fn median_build_is_identical_for_any_thread_count() {
+    let mesh = soup(20_000, 42);
+    let build = || Bvh::build_median(&mesh, &BvhParams::default());
+    let (one, four) = (on_threads(1, build), on_threads(4, build));
+    assert_eq!(one.nodes(), four.nodes());
+    assert_eq!(one.prim_indices(), four.prim_indices());
+}
+
+#[test]
+fn median_depth_is_logarithmic_on_exponentially_spaced_centroids() {
+    let mut mesh = TriangleMesh::default();
+    for i in 0..2000 {
+        let x = 0.93f32.powi(i);
+        let k = mesh.positions.len() as u32;
+        mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
+        mesh.indices.push([k, k + 1, k + 2]);
+    }
+    let bvh = Bvh::build_median(&mesh, &BvhParams::default());
+    bvh.validate(&mesh).unwrap();
+    assert!(Accel::<TriangleMesh>::stats(&bvh).max_depth <= 11);
+}
+
+#[test]
+fn median_sah_cost_is_within_a_sane_factor_of_binned_sah() {
+    let mesh = soup(20_000, 43);
+    let (median, binned) =
+        (Bvh::build_median(&mesh, &BvhParams::default()), Bvh::build_sah(&mesh, &BvhParams::default()));
+    assert!(sah(&median) < 2.0 * sah(&binned), "median {} binned {}", sah(&median), sah(&binned));
 }
