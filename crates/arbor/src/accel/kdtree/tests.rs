@@ -200,3 +200,37 @@ fn kdtree_params_parse_and_depth_limit_holds() {
     tree.validate(&mesh).unwrap();
     assert!(Accel::<TriangleMesh>::stats(&tree).max_depth < MAX_DEPTH);
 }
+
+/// One-off timing on a real mesh (`cargo test -p arbor --lib kdtree_builds_the_bunny -- --ignored
+/// --nocapture`): ignored by default, it reads a file outside the repository.
+#[test]
+#[ignore]
+fn kdtree_builds_the_bunny() {
+    let path = std::path::Path::new("/work/shared/meshes/stanford-bunny.obj");
+    let mesh = crate::mesh_io::load_mesh(path).unwrap();
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    let s = Accel::<TriangleMesh>::stats(&tree);
+    println!(
+        "{} triangles: {:?}, {} nodes, {} leaves, depth {} (mean {:.1}), refs/prim {:.2}, prims/leaf {:.2}, \
+         SAH {:.1}, {} KiB",
+        mesh.len(),
+        s.build_time,
+        s.nodes,
+        s.leaves,
+        s.max_depth,
+        s.mean_depth,
+        s.refs_per_prim,
+        s.mean_leaf_prims,
+        s.sah_cost,
+        s.bytes / 1024
+    );
+    tree.validate(&mesh).unwrap();
+    let b = Accel::<TriangleMesh>::bounds(&tree);
+    let brute = BruteForce::build(&mesh);
+    let mut rng = Rng(29);
+    for _ in 0..300 {
+        let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+        let ray = Ray::new(o, b.center() + (rng.vec3() - 0.5) * b.extent() - o);
+        assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), brute.intersect(&mesh, &ray, f32::INFINITY));
+    }
+}
