@@ -190,9 +190,10 @@ fn kdtree_params_parse_and_depth_limit_holds() {
     let tree = KdTree::build(&mesh, &p);
     assert!(Accel::<TriangleMesh>::stats(&tree).max_depth <= 3);
     assert_matches_brute(&mesh, &tree, 23, 500);
-    for preset in [KdTreeParams::fast_build(), KdTreeParams::quality()] {
+    for preset in [KdTreeParams::fast_build(), KdTreeParams::wald_havran(), KdTreeParams::pbrt()] {
         let tree = KdTree::build(&mesh, &preset);
         tree.validate(&mesh).unwrap();
+        assert_matches_brute(&mesh, &tree, 29, 500);
     }
     let silly =
         KdTreeParams { traversal_cost: f32::NAN, intersection_cost: -1.0, empty_bonus: 7.0, max_depth: Some(1000) };
@@ -232,5 +233,19 @@ fn kdtree_builds_the_bunny() {
         let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
         let ray = Ray::new(o, b.center() + (rng.vec3() - 0.5) * b.extent() - o);
         assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), brute.intersect(&mesh, &ray, f32::INFINITY));
+    }
+    // Rays from around the mesh through it, against the SAH BVH on the same rays (one thread).
+    let rays: Vec<Ray> = (0..200_000)
+        .map(|_| {
+            let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+            Ray::new(o, b.center() + (rng.vec3() - 0.5) * b.extent() - o)
+        })
+        .collect();
+    let bvh = crate::accel::build(AccelKind::BvhSah, &mesh);
+    for (name, accel) in [("kdtree", &tree as &dyn Accel<TriangleMesh>), ("bvh-sah", bvh.as_ref())] {
+        let start = std::time::Instant::now();
+        let hits = rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count();
+        let mrays = rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6;
+        println!("{name}: {mrays:.2} Mrays/s ({hits} hits)");
     }
 }
