@@ -147,6 +147,54 @@ fn kdtree_axis_aligned_grid_has_planar_splits_and_ties() {
 }
 
 #[test]
+fn kdtree_rays_in_and_across_split_planes_match_brute_force() {
+    // Unit squares on the planes x = 0..6, and small triangles around them: splits land on the planes.
+    let mut tris = Vec::new();
+    for x in 0..6 {
+        let p = |y: f32, z: f32| Vec3::new(x as f32, y, z);
+        tris.push([p(0.0, 0.0), p(4.0, 0.0), p(4.0, 4.0)]);
+        tris.push([p(0.0, 0.0), p(4.0, 4.0), p(0.0, 4.0)]);
+    }
+    let mut rng = Rng(31);
+    tris.extend((0..200).map(|_| {
+        let c = rng.vec3() * Vec3::new(5.0, 4.0, 4.0);
+        [0; 3].map(|_| c + (rng.vec3() - 0.5) * 0.6)
+    }));
+    let mesh = mesh_of(&tris);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let brute = BruteForce::build(&mesh);
+    // Every split plane of the tree, with rays starting exactly on it: parallel to it (both signs of
+    // zero), through it, and along the other axes.
+    let mut planes = Vec::new();
+    tree.walk(|_, n, _, _| {
+        if !n.is_leaf() {
+            planes.push((n.axis(), n.split()));
+        }
+    });
+    assert!(planes.len() > 10);
+    for &(axis, split) in planes.iter().take(200) {
+        for k in 0..20 {
+            let mut o = rng.vec3() * 6.0 - 0.5;
+            o[axis] = split;
+            let mut d = rng.vec3() - 0.5;
+            match k % 4 {
+                0 => d[axis] = 0.0,
+                1 => d[axis] = -0.0,
+                2 => d = Vec3::ZERO.with_x(if k % 8 == 2 { 1.0 } else { -1.0 }),
+                _ => {}
+            }
+            let ray = Ray::new(o, d);
+            for t_max in [f32::INFINITY, 1.5] {
+                let want = brute.intersect(&mesh, &ray, t_max);
+                assert_eq!(tree.intersect(&mesh, &ray, t_max), want, "{ray:?} on split {split} axis {axis}");
+                assert_eq!(tree.occluded(&mesh, &ray, t_max), want.is_some(), "{ray:?}");
+            }
+        }
+    }
+}
+
+#[test]
 fn kdtree_build_is_deterministic() {
     let mesh = soup(1_500, 11);
     let (a, b) = (KdTree::build(&mesh, &KdTreeParams::default()), KdTree::build(&mesh, &KdTreeParams::default()));
@@ -203,12 +251,13 @@ fn kdtree_params_parse_and_depth_limit_holds() {
 }
 
 /// One-off timing on a real mesh (`cargo test -p arbor --lib kdtree_builds_the_bunny -- --ignored
-/// --nocapture`): ignored by default, it reads a file outside the repository.
+/// --nocapture`, another mesh with `ARBOR_MESH=path`): ignored by default, it reads a file outside the
+/// repository.
 #[test]
 #[ignore]
 fn kdtree_builds_the_bunny() {
-    let path = std::path::Path::new("/work/shared/meshes/stanford-bunny.obj");
-    let mesh = crate::mesh_io::load_mesh(path).unwrap();
+    let path = std::env::var("ARBOR_MESH").unwrap_or("/work/shared/meshes/stanford-bunny.obj".into());
+    let mesh = crate::mesh_io::load_mesh(std::path::Path::new(&path)).unwrap();
     let tree = KdTree::build(&mesh, &KdTreeParams::default());
     let s = Accel::<TriangleMesh>::stats(&tree);
     println!(
