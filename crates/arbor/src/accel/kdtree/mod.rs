@@ -17,9 +17,13 @@
 //! - each split lies strictly inside its node's box; the tree is less than [`MAX_DEPTH`] deep, which sizes
 //!   the traversal stack.
 //!
-//! Cost: the build sorts the events once (O(N log N)) and then does O(n) work per node level (sweep,
-//! classification, a linear merge), plus sorting only the events of primitives that straddle a split;
-//! O(N log N) overall. Memory: 8 bytes per node, 4 per reference. Queries are O(log N) on typical scenes.
+//! Cost: the build sorts the events once (O(N log N)) and then does O(n) work per node (sweep,
+//! classification, a linear merge) plus a sort of the new events of the primitives straddling the
+//! split: O(N log N) overall under the paper's assumption that O(sqrt n) primitives straddle a node's
+//! split (the full algorithm, not the O(N log² N) sort-per-node variant). Unlike the paper, which keeps
+//! one list for all three axes, the events are kept in one list per axis; the work is the same. The
+//! build is single-threaded and deterministic. Memory: 8 bytes per node, 4 per reference of leaves of
+//! two or more. Queries are O(log N) on typical scenes.
 
 mod build;
 mod traverse;
