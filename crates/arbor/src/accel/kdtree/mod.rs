@@ -9,13 +9,16 @@
 //! holds its index inline; larger leaves hold a range of [`KdTree::prim_refs`], where a primitive that
 //! straddles splits appears once per leaf it touches.
 //!
-//! Invariants (checked by [`Accel::validate`], which the factory runs in debug builds):
+//! Invariants checked by [`Accel::validate`], which the factory runs in debug builds:
 //! - every reference is a primitive index in range, and every primitive with finite, non-empty bounds
 //!   is referenced at least once; the others can never be hit and are left out;
-//! - a primitive is in every leaf whose (closed) box holds a point of it, because its clipped bounds
-//!   ([`Primitives::clipped_bounds`]) are conservative; that, not the SAH, is what makes traversal exact;
+//! - every leaf's primitives have bounds that overlap the leaf's box;
 //! - each split lies strictly inside its node's box; the tree is less than [`MAX_DEPTH`] deep, which sizes
 //!   the traversal stack.
+//!
+//! And by construction: a primitive is in every leaf whose (closed) box holds a point of it, because
+//! its clipped bounds ([`Primitives::clipped_bounds`]) are conservative; that, not the SAH, is what
+//! makes traversal exact.
 //!
 //! Cost: the build sorts the events once (O(N log N)) and then does O(n) work per node (sweep,
 //! classification, a linear merge) plus a sort of the new events of the primitives straddling the
@@ -139,8 +142,8 @@ impl KdTreeParams {
     pub fn pbrt() -> Self {
         KdTreeParams { traversal_cost: 1.0, intersection_cost: 80.0, empty_bonus: 0.5, max_depth: None }
     }
-    /// Costlier traversal: a smaller tree built in about half the time, tracing at nearly the same
-    /// speed on the bunny.
+    /// Costlier traversal: on the bunny, a tree of 2.5 references per triangle instead of 3.6, built
+    /// in about two thirds of the time, tracing at nearly the same speed.
     pub fn fast_build() -> Self {
         KdTreeParams { traversal_cost: 60.0, ..Self::default() }
     }
