@@ -195,6 +195,42 @@ fn kdtree_rays_in_and_across_split_planes_match_brute_force() {
 }
 
 #[test]
+fn kdtree_presets_match_brute_force_offset_scaled_and_on_vertices() {
+    // The conformance suite builds with the defaults; the presets give deeper (pbrt) or shallower trees.
+    let mut rng = Rng(37);
+    let base: Vec<[Vec3; 3]> = (0..300)
+        .map(|_| {
+            let c = rng.vec3() * 10.0;
+            [0; 3].map(|_| c + (rng.vec3() - 0.5) * 1.5)
+        })
+        .collect();
+    for map in [|p: Vec3| p + Vec3::splat(1e5), |p: Vec3| p * 1e-4] {
+        let tris: Vec<_> = base.iter().map(|t| t.map(map)).collect();
+        let mesh = mesh_of(&tris);
+        let brute = BruteForce::build(&mesh);
+        for params in
+            [KdTreeParams::default(), KdTreeParams::wald_havran(), KdTreeParams::pbrt(), KdTreeParams::fast_build()]
+        {
+            let tree = KdTree::build(&mesh, &params);
+            tree.validate(&mesh).unwrap();
+            let b = Accel::<TriangleMesh>::bounds(&tree);
+            for i in 0..2_000 {
+                let target = tris[i % tris.len()][i % 3];
+                let o = match i % 3 {
+                    0 => b.min + (rng.vec3() * 2.0 - 0.5) * b.extent(),
+                    1 => tris[(i * 7) % tris.len()][(i + 1) % 3],
+                    _ => Aabb::from_points(tris[(i * 3) % tris.len()]).center(),
+                };
+                let ray = Ray::new(o, if i % 5 == 0 { rng.vec3() - 0.5 } else { target - o });
+                let want = brute.intersect(&mesh, &ray, f32::INFINITY);
+                assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), want, "{params:?} {ray:?}");
+                assert_eq!(tree.occluded(&mesh, &ray, f32::INFINITY), want.is_some(), "{params:?} {ray:?}");
+            }
+        }
+    }
+}
+
+#[test]
 fn kdtree_build_is_deterministic() {
     let mesh = soup(1_500, 11);
     let (a, b) = (KdTree::build(&mesh, &KdTreeParams::default()), KdTree::build(&mesh, &KdTreeParams::default()));
