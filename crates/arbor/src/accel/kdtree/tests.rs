@@ -1,0 +1,336 @@
+//! Unit tests of the kd-tree: structure, hostile inputs, determinism, parameters. Equality with brute
+//! force on many rays is the job of `tests/accel_conformance.rs`.
+
+use super::*;
+use crate::accel::{AccelKind, AccelSpec, BruteForce};
+use crate::geometry::TriangleMesh;
+use crate::math::Vec3;
+
+/// xorshift64*: small, seeded, good enough to scatter triangles.
+struct Rng(u64);
+
+impl Rng {
+    fn f32(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn vec3(&mut self) -> Vec3 {
+        Vec3::new(self.f32(), self.f32(), self.f32())
+    }
+}
+
+fn mesh_of(tris: &[[Vec3; 3]]) -> TriangleMesh {
+    TriangleMesh {
+        positions: tris.iter().flatten().copied().collect(),
+        indices: (0..tris.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect(),
+        ..Default::default()
+    }
+}
+
+fn soup(n: usize, seed: u64) -> TriangleMesh {
+    let mut rng = Rng(seed);
+    let tris: Vec<_> = (0..n)
+        .map(|_| {
+            let c = rng.vec3() * 10.0;
+            [0; 3].map(|_| c + rng.vec3() - 0.5)
+        })
+        .collect();
+    mesh_of(&tris)
+}
+
+fn assert_matches_brute(mesh: &TriangleMesh, tree: &KdTree, seed: u64, n: usize) {
+    let brute = BruteForce::build(mesh);
+    let mut rng = Rng(seed);
+    for _ in 0..n {
+        let ray = Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5);
+        let (a, b) = (tree.intersect(mesh, &ray, f32::INFINITY), brute.intersect(mesh, &ray, f32::INFINITY));
+        assert_eq!(a, b, "ray {ray:?}");
+        assert_eq!(tree.occluded(mesh, &ray, 5.0), brute.occluded(mesh, &ray, 5.0), "ray {ray:?}");
+    }
+}
+
+#[test]
+fn kdtree_node_is_eight_bytes_and_packs_its_fields() {
+    assert_eq!(std::mem::size_of::<Node>(), 8);
+    let n = Node::inner(2, -1.5, 12345);
+    assert!(!n.is_leaf());
+    assert_eq!((n.axis(), n.split(), n.above()), (2, -1.5, 12345));
+    let l = Node::leaf(1, 77);
+    assert!(l.is_leaf());
+    assert_eq!(l.prims(&[]), &[77]);
+    let l = Node::leaf(2, 1);
+    assert_eq!(l.prims(&[9, 4, 6]), &[4, 6]);
+}
+
+#[test]
+fn kdtree_empty_set_hits_nothing() {
+    let mesh = TriangleMesh::default();
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let ray = Ray::new(Vec3::ZERO, Vec3::X);
+    assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), None);
+    assert!(!tree.occluded(&mesh, &ray, f32::INFINITY));
+    assert!(Accel::<TriangleMesh>::bounds(&tree).is_empty());
+    assert_eq!(Accel::<TriangleMesh>::stats(&tree).nodes, 0);
+    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0).is_empty());
+}
+
+#[test]
+fn kdtree_matches_brute_force_on_random_soup() {
+    let mesh = soup(2_000, 7);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    assert_matches_brute(&mesh, &tree, 99, 3_000);
+    let stats = Accel::<TriangleMesh>::stats(&tree);
+    assert!(stats.nodes > 100 && stats.leaves * 2 == stats.nodes + 1, "{stats:?}");
+    assert!(stats.refs_per_prim >= 1.0 && stats.mean_depth > 1.0 && stats.sah_cost > 0.0, "{stats:?}");
+    assert!(stats.max_depth < MAX_DEPTH && stats.bytes >= 8 * stats.nodes, "{stats:?}");
+}
+
+#[test]
+fn kdtree_perfect_splits_keep_references_low() {
+    // Long thin diagonal triangles: their boxes overlap many cells, the triangles few.
+    let mut rng = Rng(3);
+    let tris: Vec<_> = (0..1_000)
+        .map(|_| {
+            let a = rng.vec3() * 10.0;
+            [a, a + Vec3::splat(2.0), a + Vec3::new(2.0, 2.0, 2.05)]
+        })
+        .collect();
+    let mesh = mesh_of(&tris);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    assert_matches_brute(&mesh, &tree, 5, 2_000);
+}
+
+#[test]
+fn kdtree_drops_non_finite_and_handles_duplicates() {
+    let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let nan = [Vec3::splat(f32::NAN); 3];
+    let inf = [Vec3::ZERO, Vec3::X, Vec3::new(0.0, f32::INFINITY, 0.0)];
+    let mesh = mesh_of(&[nan, t, t, inf, t]);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+    assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim), Some(1));
+}
+
+#[test]
+fn kdtree_axis_aligned_grid_has_planar_splits_and_ties() {
+    // Unit squares on the planes z = 0..8: every split candidate is planar.
+    let mut tris = Vec::new();
+    for z in 0..8 {
+        for i in 0..4 {
+            for j in 0..4 {
+                let p = |di: u32, dj: u32| Vec3::new((i + di) as f32, (j + dj) as f32, z as f32);
+                tris.push([p(0, 0), p(1, 0), p(1, 1)]);
+                tris.push([p(0, 0), p(1, 1), p(0, 1)]);
+            }
+        }
+    }
+    let mesh = mesh_of(&tris);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let brute = BruteForce::build(&mesh);
+    for (o, d) in [
+        (Vec3::new(1.0, 1.0, -1.0), Vec3::Z),
+        (Vec3::new(2.0, 0.5, 9.0), -Vec3::Z),
+        (Vec3::new(0.5, 0.5, 3.0), Vec3::X),
+        (Vec3::new(1.0, 1.0, 3.0), Vec3::new(0.0, 0.0, 1.0)),
+        (Vec3::new(-1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 2.0)),
+    ] {
+        let ray = Ray::new(o, d);
+        assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), brute.intersect(&mesh, &ray, f32::INFINITY));
+    }
+}
+
+#[test]
+fn kdtree_rays_in_and_across_split_planes_match_brute_force() {
+    // Unit squares on the planes x = 0..6, and small triangles around them: splits land on the planes.
+    let mut tris = Vec::new();
+    for x in 0..6 {
+        let p = |y: f32, z: f32| Vec3::new(x as f32, y, z);
+        tris.push([p(0.0, 0.0), p(4.0, 0.0), p(4.0, 4.0)]);
+        tris.push([p(0.0, 0.0), p(4.0, 4.0), p(0.0, 4.0)]);
+    }
+    let mut rng = Rng(31);
+    tris.extend((0..200).map(|_| {
+        let c = rng.vec3() * Vec3::new(5.0, 4.0, 4.0);
+        [0; 3].map(|_| c + (rng.vec3() - 0.5) * 0.6)
+    }));
+    let mesh = mesh_of(&tris);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let brute = BruteForce::build(&mesh);
+    // Every split plane of the tree, with rays starting exactly on it: parallel to it (both signs of
+    // zero), through it, and along the other axes.
+    let mut planes = Vec::new();
+    tree.walk(|_, n, _, _| {
+        if !n.is_leaf() {
+            planes.push((n.axis(), n.split()));
+        }
+    });
+    assert!(planes.len() > 10);
+    for &(axis, split) in planes.iter().take(200) {
+        for k in 0..20 {
+            let mut o = rng.vec3() * 6.0 - 0.5;
+            o[axis] = split;
+            let mut d = rng.vec3() - 0.5;
+            match k % 4 {
+                0 => d[axis] = 0.0,
+                1 => d[axis] = -0.0,
+                2 => d = Vec3::ZERO.with_x(if k % 8 == 2 { 1.0 } else { -1.0 }),
+                _ => {}
+            }
+            let ray = Ray::new(o, d);
+            for t_max in [f32::INFINITY, 1.5] {
+                let want = brute.intersect(&mesh, &ray, t_max);
+                assert_eq!(tree.intersect(&mesh, &ray, t_max), want, "{ray:?} on split {split} axis {axis}");
+                assert_eq!(tree.occluded(&mesh, &ray, t_max), want.is_some(), "{ray:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn kdtree_presets_match_brute_force_offset_scaled_and_on_vertices() {
+    // The conformance suite builds with the defaults; the presets give deeper (pbrt) or shallower trees.
+    let mut rng = Rng(37);
+    let base: Vec<[Vec3; 3]> = (0..300)
+        .map(|_| {
+            let c = rng.vec3() * 10.0;
+            [0; 3].map(|_| c + (rng.vec3() - 0.5) * 1.5)
+        })
+        .collect();
+    for map in [|p: Vec3| p + Vec3::splat(1e5), |p: Vec3| p * 1e-4] {
+        let tris: Vec<_> = base.iter().map(|t| t.map(map)).collect();
+        let mesh = mesh_of(&tris);
+        let brute = BruteForce::build(&mesh);
+        for params in
+            [KdTreeParams::default(), KdTreeParams::wald_havran(), KdTreeParams::pbrt(), KdTreeParams::fast_build()]
+        {
+            let tree = KdTree::build(&mesh, &params);
+            tree.validate(&mesh).unwrap();
+            let b = Accel::<TriangleMesh>::bounds(&tree);
+            for i in 0..2_000 {
+                let target = tris[i % tris.len()][i % 3];
+                let o = match i % 3 {
+                    0 => b.min + (rng.vec3() * 2.0 - 0.5) * b.extent(),
+                    1 => tris[(i * 7) % tris.len()][(i + 1) % 3],
+                    _ => Aabb::from_points(tris[(i * 3) % tris.len()]).center(),
+                };
+                let ray = Ray::new(o, if i % 5 == 0 { rng.vec3() - 0.5 } else { target - o });
+                let want = brute.intersect(&mesh, &ray, f32::INFINITY);
+                assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), want, "{params:?} {ray:?}");
+                assert_eq!(tree.occluded(&mesh, &ray, f32::INFINITY), want.is_some(), "{params:?} {ray:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn kdtree_build_is_deterministic() {
+    let mesh = soup(1_500, 11);
+    let (a, b) = (KdTree::build(&mesh, &KdTreeParams::default()), KdTree::build(&mesh, &KdTreeParams::default()));
+    assert_eq!(a.nodes(), b.nodes());
+    assert_eq!(a.prim_refs(), b.prim_refs());
+}
+
+#[test]
+fn kdtree_counted_traversal_reports_work() {
+    let mesh = soup(500, 13);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    let ray = Ray::new(Vec3::new(-1.0, 5.0, 5.0), Vec3::X);
+    let mut counts = TraversalCounts::default();
+    let hit = tree.intersect_counted(&mesh, &ray, f32::INFINITY, &mut counts);
+    assert_eq!(hit, tree.intersect(&mesh, &ray, f32::INFINITY));
+    assert!(counts.nodes > 0 && counts.prims > 0);
+}
+
+#[test]
+fn kdtree_boxes_at_depth_tile_the_root() {
+    let mesh = soup(800, 17);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    let root = Accel::<TriangleMesh>::bounds(&tree);
+    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0), vec![root]);
+    let level: Vec<Aabb> = Accel::<TriangleMesh>::boxes_at_depth(&tree, 1);
+    assert_eq!(level.len(), 2);
+    let volume = |b: &Aabb| b.extent().x * b.extent().y * b.extent().z;
+    assert!((level.iter().map(volume).sum::<f32>() - volume(&root)).abs() <= 1e-3 * volume(&root));
+}
+
+#[test]
+fn kdtree_params_parse_and_depth_limit_holds() {
+    let spec = AccelSpec::new(AccelKind::KdTree)
+        .with_params(["traversal-cost=10", "intersection-cost=30", "empty-bonus=0.5", "depth=3"])
+        .unwrap();
+    let p: KdTreeParams = spec.parse().unwrap();
+    assert_eq!(p, KdTreeParams { traversal_cost: 10.0, intersection_cost: 30.0, empty_bonus: 0.5, max_depth: Some(3) });
+    let bad = AccelSpec::new(AccelKind::KdTree).with_params(["bins=3"]).unwrap();
+    assert!(bad.parse::<KdTreeParams>().unwrap_err().contains("no parameter 'bins'"));
+    let mesh = soup(1_000, 19);
+    let tree = KdTree::build(&mesh, &p);
+    assert!(Accel::<TriangleMesh>::stats(&tree).max_depth <= 3);
+    assert_matches_brute(&mesh, &tree, 23, 500);
+    for preset in [KdTreeParams::fast_build(), KdTreeParams::wald_havran(), KdTreeParams::pbrt()] {
+        let tree = KdTree::build(&mesh, &preset);
+        tree.validate(&mesh).unwrap();
+        assert_matches_brute(&mesh, &tree, 29, 500);
+    }
+    let silly =
+        KdTreeParams { traversal_cost: f32::NAN, intersection_cost: -1.0, empty_bonus: 7.0, max_depth: Some(1000) };
+    let tree = KdTree::build(&mesh, &silly);
+    tree.validate(&mesh).unwrap();
+    assert!(Accel::<TriangleMesh>::stats(&tree).max_depth < MAX_DEPTH);
+}
+
+/// One-off timing on a real mesh (`cargo test -p arbor --lib kdtree_builds_the_bunny -- --ignored
+/// --nocapture`, another mesh with `ARBOR_MESH=path`): ignored by default, it reads a file outside the
+/// repository.
+#[test]
+#[ignore]
+fn kdtree_builds_the_bunny() {
+    let path = std::env::var("ARBOR_MESH").unwrap_or("/work/shared/meshes/stanford-bunny.obj".into());
+    let mesh = crate::mesh_io::load_mesh(std::path::Path::new(&path)).unwrap();
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    let s = Accel::<TriangleMesh>::stats(&tree);
+    println!(
+        "{} triangles: {:?}, {} nodes, {} leaves, depth {} (mean {:.1}), refs/prim {:.2}, prims/leaf {:.2}, \
+         SAH {:.1}, {} KiB",
+        mesh.len(),
+        s.build_time,
+        s.nodes,
+        s.leaves,
+        s.max_depth,
+        s.mean_depth,
+        s.refs_per_prim,
+        s.mean_leaf_prims,
+        s.sah_cost,
+        s.bytes / 1024
+    );
+    tree.validate(&mesh).unwrap();
+    let b = Accel::<TriangleMesh>::bounds(&tree);
+    let brute = BruteForce::build(&mesh);
+    let mut rng = Rng(29);
+    for _ in 0..300 {
+        let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+        let ray = Ray::new(o, b.center() + (rng.vec3() - 0.5) * b.extent() - o);
+        assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), brute.intersect(&mesh, &ray, f32::INFINITY));
+    }
+    // Rays from around the mesh through it, against the SAH BVH on the same rays (one thread).
+    let rays: Vec<Ray> = (0..200_000)
+        .map(|_| {
+            let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+            Ray::new(o, b.center() + (rng.vec3() - 0.5) * b.extent() - o)
+        })
+        .collect();
+    let bvh = crate::accel::build(AccelKind::BvhSah, &mesh);
+    for (name, accel) in [("kdtree", &tree as &dyn Accel<TriangleMesh>), ("bvh-sah", bvh.as_ref())] {
+        let start = std::time::Instant::now();
+        let hits = rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count();
+        let mrays = rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6;
+        println!("{name}: {mrays:.2} Mrays/s ({hits} hits)");
+    }
+}
