@@ -24,7 +24,7 @@ use std::time::Duration;
 use crate::math::{Aabb, Ray, Vec3};
 
 pub use brute::BruteForce;
-pub use bvh::{BottomUpParams, Bvh, BvhParams};
+pub use bvh::{BottomUpParams, Bvh, BvhParams, MedianParams};
 pub use kdtree::{KdTree, KdTreeParams};
 pub use octree::{Octree, OctreeParams};
 pub use params::{AccelSpec, Params};
@@ -223,7 +223,8 @@ impl AccelKind {
             AccelKind::Brute => &[],
             AccelKind::Octree => OctreeParams::KEYS,
             AccelKind::KdTree => KdTreeParams::KEYS,
-            AccelKind::BvhMedian | AccelKind::BvhSah => BvhParams::KEYS,
+            AccelKind::BvhMedian => MedianParams::KEYS,
+            AccelKind::BvhSah => BvhParams::KEYS,
             AccelKind::BvhBottomUp => BottomUpParams::KEYS,
         }
     }
@@ -252,7 +253,8 @@ impl AccelSpec {
             AccelKind::Brute => self.parse::<params::NoParams>().map(drop),
             AccelKind::Octree => self.parse::<OctreeParams>().map(drop),
             AccelKind::KdTree => self.parse::<KdTreeParams>().map(drop),
-            AccelKind::BvhMedian | AccelKind::BvhSah => self.parse::<BvhParams>().map(drop),
+            AccelKind::BvhMedian => self.parse::<MedianParams>().map(drop),
+            AccelKind::BvhSah => self.parse::<BvhParams>().map(drop),
             AccelKind::BvhBottomUp => self.parse::<BottomUpParams>().map(drop),
         }
     }

@@ -160,6 +160,30 @@ impl Params for BvhParams {
     }
 }
 
+/// Parameters of the median build: its only knob is the leaf size (no costs, no bins).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MedianParams {
+    /// Most primitives in a leaf (clamped to `1..=LEAF_HARD_MAX`).
+    pub max_leaf_prims: usize,
+}
+
+impl Default for MedianParams {
+    fn default() -> Self {
+        MedianParams { max_leaf_prims: BvhParams::default().max_leaf_prims }
+    }
+}
+
+impl Params for MedianParams {
+    const KEYS: &'static [(&'static str, &'static str)] = &[("leaf", "most primitives in a leaf (1-64)")];
+    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
+        match key {
+            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
+            _ => return Err(unknown_key("bvh-median", key, Self::KEYS)),
+        }
+        Ok(())
+    }
+}
+
 /// A bounding volume hierarchy over primitive indices.
 #[derive(Debug, Clone)]
 pub struct Bvh {
@@ -178,10 +202,11 @@ impl Bvh {
     }
 
     /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
-    /// `median.rs`); of `params`, only [`BvhParams::max_leaf_prims`] applies.
-    pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
+    /// `median.rs`).
+    pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &MedianParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = median::build_median(prims, &params.sanitized());
+        let bvh_params = BvhParams { max_leaf_prims: params.max_leaf_prims, ..BvhParams::default() };
+        let (nodes, prim_indices, live) = median::build_median(prims, &bvh_params.sanitized());
         Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
     }
 

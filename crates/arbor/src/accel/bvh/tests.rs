@@ -257,7 +257,7 @@ pub(super) fn sah(bvh: &Bvh) -> f64 {
 fn median_matches_brute_force_on_small_soup() {
     for (n, leaf) in [(1, 8), (2, 1), (200, 8), (300, 1), (500, 64)] {
         let mesh = soup(n, n as u64 + 40);
-        let bvh = Bvh::build_median(&mesh, &BvhParams { max_leaf_prims: leaf, ..BvhParams::default() });
+        let bvh = Bvh::build_median(&mesh, &MedianParams { max_leaf_prims: leaf });
         bvh.validate(&mesh).unwrap();
         assert_matches_brute(&mesh, &bvh, &rays(2000, 3));
     }
@@ -266,7 +266,7 @@ fn median_matches_brute_force_on_small_soup() {
 #[test]
 fn median_tree_is_balanced_with_bounded_leaves() {
     let mesh = soup(10_000, 41);
-    let bvh = Bvh::build_median(&mesh, &BvhParams { max_leaf_prims: 5, ..BvhParams::default() });
+    let bvh = Bvh::build_median(&mesh, &MedianParams { max_leaf_prims: 5 });
     let s = Accel::<TriangleMesh>::stats(&bvh);
     assert_eq!(s.kind, "bvh-median");
     // 10,000 halved until at most 5: every leaf at depth 11 (10,000 / 2^11 is 4.9), 3 to 5 primitives.
@@ -279,7 +279,7 @@ fn median_splits_coincident_centroids_by_index() {
     // 1,000 copies of one triangle: selection by (centroid, index) still halves them.
     let mut mesh = soup(1, 1);
     mesh.indices = vec![[0, 1, 2]; 1000];
-    let bvh = Bvh::build_median(&mesh, &BvhParams::default());
+    let bvh = Bvh::build_median(&mesh, &MedianParams::default());
     bvh.validate(&mesh).unwrap();
     assert_eq!(Accel::<TriangleMesh>::stats(&bvh).max_depth, 7);
     assert_matches_brute(&mesh, &bvh, &rays(500, 2));
@@ -288,7 +288,7 @@ fn median_splits_coincident_centroids_by_index() {
 #[test]
 fn median_build_is_identical_for_any_thread_count() {
     let mesh = soup(20_000, 42);
-    let build = || Bvh::build_median(&mesh, &BvhParams::default());
+    let build = || Bvh::build_median(&mesh, &MedianParams::default());
     let (one, four) = (on_threads(1, build), on_threads(4, build));
     assert_eq!(one.nodes(), four.nodes());
     assert_eq!(one.prim_indices(), four.prim_indices());
@@ -303,7 +303,7 @@ fn median_depth_is_logarithmic_on_exponentially_spaced_centroids() {
         mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
         mesh.indices.push([k, k + 1, k + 2]);
     }
-    let bvh = Bvh::build_median(&mesh, &BvhParams::default());
+    let bvh = Bvh::build_median(&mesh, &MedianParams::default());
     bvh.validate(&mesh).unwrap();
     assert!(Accel::<TriangleMesh>::stats(&bvh).max_depth <= 11);
 }
@@ -312,6 +312,6 @@ fn median_depth_is_logarithmic_on_exponentially_spaced_centroids() {
 fn median_sah_cost_is_within_a_sane_factor_of_binned_sah() {
     let mesh = soup(20_000, 43);
     let (median, binned) =
-        (Bvh::build_median(&mesh, &BvhParams::default()), Bvh::build_sah(&mesh, &BvhParams::default()));
+        (Bvh::build_median(&mesh, &MedianParams::default()), Bvh::build_sah(&mesh, &BvhParams::default()));
     assert!(sah(&median) < 2.0 * sah(&binned), "median {} binned {}", sah(&median), sah(&binned));
 }

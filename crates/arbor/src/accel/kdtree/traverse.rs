@@ -186,7 +186,7 @@ pub(super) fn occluded<P: Primitives + ?Sized>(tree: &KdTree, prims: &P, ray: &R
             at = near;
             continue;
         }
-        if node.prims(&tree.refs).iter().any(|&p| prims.intersect(p as usize, ray, t_max).is_some()) {
+        if node.prims(&tree.refs).iter().any(|&p| prims.occludes(p as usize, ray, t_max)) {
             return true;
         }
         if sp == 0 {
