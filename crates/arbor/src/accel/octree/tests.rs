@@ -201,3 +201,37 @@ fn octree_bunny_builds_in_reasonable_time_and_depth() {
         println!("validate {:?}", start.elapsed());
     }
 }
+
+/// A one-off timing against the SAH BVH on the same rays (not a benchmark: `arbor bench` is).
+#[test]
+#[ignore]
+fn octree_bunny_traversal_timing_against_bvh() {
+    let path = std::path::Path::new("/work/shared/meshes/stanford-bunny.obj");
+    let mesh = crate::mesh_io::load_mesh(path).unwrap();
+    let b = Accel::<TriangleMesh>::bounds(&Octree::build(&mesh, &OctreeParams::default()));
+    let mut rng = Rng(3);
+    let rays: Vec<Ray> = (0..200_000)
+        .map(|_| {
+            let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+            let target = b.min + rng.vec3() * b.extent();
+            Ray::new(o, target - o)
+        })
+        .collect();
+    for kind in [AccelKind::Octree, AccelKind::BvhSah] {
+        let accel = crate::accel::build(kind, &mesh);
+        let mut counts = TraversalCounts::default();
+        for r in &rays {
+            accel.intersect_counted(&mesh, r, f32::INFINITY, &mut counts);
+        }
+        let start = std::time::Instant::now();
+        let hits = rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count();
+        let secs = start.elapsed().as_secs_f64();
+        let n = rays.len() as f64;
+        println!(
+            "{kind}: {:.2} Mrays/s, {hits} hits, {:.1} nodes/ray, {:.1} prims/ray",
+            n / secs / 1e6,
+            counts.nodes as f64 / n,
+            counts.prims as f64 / n
+        );
+    }
+}

@@ -19,20 +19,21 @@
 //!   and `min` ignore: the ray counts as inside that slab (the closed-cell answer). Children share
 //!   bit-identical faces with their neighbours, so their intervals meet exactly.
 //!
-//! Cost: per inner cell, eight slab tests and a sort of at most eight entries (a ray crosses at most
+//! Cost: per inner cell, nine plane distances and a sort of at most eight entries (a ray crosses at most
 //! four octants, more only along split planes); at most eight cells are pushed per level, which sizes
 //! the stack.
 
 use super::{child_box, split_point, Octree, MAX_DEPTH};
 use crate::accel::{Hit, Primitives, TraversalCounts};
-use crate::math::{Aabb, Ray};
+use crate::math::{Aabb, Ray, Vec3};
 
 /// Slack of the interval tests, relative to the root's extent in `t` along the ray's major axis
 /// (2^-16); see the module docs.
 const SLACK: f32 = 1.0 / 65_536.0;
 
-/// Deepest stack: up to eight octants pushed at each level, plus the root.
-const STACK: usize = 8 * (MAX_DEPTH + 1);
+/// Deepest stack: each inner level pops one cell and pushes at most eight, and leaves are at depth
+/// [`MAX_DEPTH`] at most, so `1 + 7 * MAX_DEPTH` entries.
+const STACK: usize = 1 + 7 * MAX_DEPTH;
 
 /// A ray prepared for interval tests.
 struct RayCells {
@@ -82,6 +83,28 @@ impl RayCells {
     fn visits(&self, entry: f32, exit: f32, limit: f32) -> bool {
         entry - self.slack <= exit + self.slack && entry - self.slack <= limit
     }
+
+    /// The intervals of the eight octants of `b` cut at `mid`: the nine plane distances are computed
+    /// once, with the same expressions as [`RayCells::interval`] on each octant's box (bit-identical).
+    #[inline]
+    fn octant_intervals(&self, b: &Aabb, mid: Vec3) -> [(f32, f32); 8] {
+        // Per axis, (near, far) of the lower and the upper half.
+        let mut halves = [[(0.0f32, 0.0f32); 2]; 3];
+        for (a, h) in halves.iter_mut().enumerate() {
+            let t = |x: f32| (x - self.origin[a]) * self.inv_dir[a];
+            let (lo, m, hi) = (t(b.min[a]), t(mid[a]), t(b.max[a]));
+            *h = if self.negative[a] { [(m, lo), (hi, m)] } else { [(lo, m), (m, hi)] };
+        }
+        let mut out = [(0.0f32, f32::INFINITY); 8];
+        for (k, o) in out.iter_mut().enumerate() {
+            for (a, h) in halves.iter().enumerate() {
+                let (near, far) = h[(k >> a) & 1];
+                o.0 = o.0.max(near);
+                o.1 = o.1.min(far);
+            }
+        }
+        out
+    }
 }
 
 /// A cell waiting on the stack.
@@ -118,6 +141,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
     let mut limit = t_max;
     // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
     let mut t_query = t_max;
+    let mut mailbox = Mailbox::default();
     while sp > 0 {
         sp -= 1;
         let p = stack[sp];
@@ -130,6 +154,9 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
         let node = nodes[p.node as usize];
         if node.is_leaf() {
             for &prim in &refs[node.range()] {
+                if !mailbox.first_visit(prim) {
+                    continue;
+                }
                 let h = if COUNT {
                     prims.intersect_counted(prim as usize, ray, t_query, counts)
                 } else {
@@ -153,16 +180,16 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
         }
         // Children crossed, sorted by decreasing entry so that the nearest is popped first.
         let mid = split_point(&p.cell);
+        let intervals = rc.octant_intervals(&p.cell, mid);
         let mut crossed = [root; 8];
         let mut n = 0;
-        for k in 0..8 {
+        for (k, &(entry, exit)) in intervals.iter().enumerate() {
             let child = node.offset + k as u32;
-            if nodes[child as usize].count == 0 {
-                continue; // an empty leaf
+            if nodes[child as usize].count == 0 || !rc.visits(entry, exit, limit) {
+                continue; // an empty leaf, or not crossed
             }
             let cell = child_box(&p.cell, mid, k);
-            let (entry, exit) = rc.interval(&cell);
-            if rc.visits(entry, exit, limit) {
+            {
                 let mut j = n;
                 while j > 0 && crossed[j - 1].entry < entry {
                     crossed[j] = crossed[j - 1];
@@ -176,6 +203,34 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
         sp += n;
     }
     best
+}
+
+/// The last primitives tested (Amanatides and Woo 1987's mailbox, as a small ring): a primitive
+/// referenced by several cells along the ray is tested once. Skipping a repeat is exact: its hit, if
+/// any, was already weighed against a best `t` that has only decreased since.
+#[derive(Default)]
+struct Mailbox {
+    ids: [u32; MAILBOX],
+    next: usize,
+    full: bool,
+}
+
+/// Entries of the mailbox: a ray usually meets a few leaves of a few primitives before its hit.
+const MAILBOX: usize = 16;
+
+impl Mailbox {
+    /// False when `prim` was tested recently; otherwise records it.
+    #[inline]
+    fn first_visit(&mut self, prim: u32) -> bool {
+        let used = if self.full { MAILBOX } else { self.next };
+        if self.ids[..used].contains(&prim) {
+            return false;
+        }
+        self.ids[self.next] = prim;
+        self.next = (self.next + 1) % MAILBOX;
+        self.full |= self.next == 0;
+        true
+    }
 }
 
 /// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
