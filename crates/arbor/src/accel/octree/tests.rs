@@ -217,8 +217,16 @@ fn octree_bunny_traversal_timing_against_bvh() {
             Ray::new(o, target - o)
         })
         .collect();
-    for kind in [AccelKind::Octree, AccelKind::BvhSah] {
-        let accel = crate::accel::build(kind, &mesh);
+    let specs = [
+        ("octree", vec![]),
+        ("octree", vec!["leaf=16", "depth=8"]),
+        ("octree", vec!["leaf=4", "depth=12"]),
+        ("bvh-sah", vec![]),
+    ];
+    for (kind, params) in specs {
+        let spec = AccelSpec::new(kind.parse().unwrap()).with_params(params.iter().copied()).unwrap();
+        let accel = build_with(&spec, &mesh).unwrap();
+        let kind = format!("{kind} {params:?}");
         let mut counts = TraversalCounts::default();
         for r in &rays {
             accel.intersect_counted(&mesh, r, f32::INFINITY, &mut counts);
