@@ -186,19 +186,53 @@ fn octree_validate_catches_a_missing_reference() {
     assert!(tree.validate(&mesh).is_err());
 }
 
-/// The 100k-triangle timing of the report: `cargo test -p arbor --lib octree_bunny -- --ignored --nocapture`.
+/// A mesh from `$ARBOR_MESHES` or `../shared/meshes` beside the checkout, if present.
+fn shared_mesh(name: &str) -> Option<TriangleMesh> {
+    let dir = std::env::var_os("ARBOR_MESHES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes"));
+    let path = dir.join(name);
+    let mesh = crate::mesh_io::load_mesh(&path);
+    if mesh.is_err() {
+        eprintln!("SKIPPED: {} not loaded", path.display());
+    }
+    mesh.ok()
+}
+
+fn bunny() -> Option<TriangleMesh> {
+    shared_mesh("stanford-bunny.obj")
+}
+
+/// Build numbers of the report, on the shared meshes with the three presets:
+/// `cargo test -p arbor --lib octree_real_meshes -- --ignored --nocapture`.
 #[test]
 #[ignore]
-fn octree_bunny_builds_in_reasonable_time_and_depth() {
-    let path = std::path::Path::new("/work/shared/meshes/stanford-bunny.obj");
-    let mesh = crate::mesh_io::load_mesh(path).unwrap();
-    for params in [OctreeParams::default(), OctreeParams::fast_build(), OctreeParams::quality()] {
-        let tree = Octree::build(&mesh, &params);
-        let s = Accel::<TriangleMesh>::stats(&tree);
-        println!("{params:?}: {} tris, {:?}, {s:?}", mesh.len(), s.build_time);
-        let start = std::time::Instant::now();
-        tree.validate(&mesh).unwrap();
-        println!("validate {:?}", start.elapsed());
+fn octree_real_meshes_build_in_reasonable_time_and_depth() {
+    for name in ["stanford-bunny.obj", "horse.ply", "igea.ply", "nefertiti.obj", "ogre.obj"] {
+        let Some(mesh) = shared_mesh(name) else { continue };
+        for params in [OctreeParams::default(), OctreeParams::fast_build(), OctreeParams::quality()] {
+            let tree = Octree::build(&mesh, &params);
+            let s = Accel::<TriangleMesh>::stats(&tree);
+            let start = std::time::Instant::now();
+            tree.validate(&mesh).unwrap();
+            println!(
+                "{name} {} tris, leaf {} depth {}: build {:.0} ms, {} nodes, {} leaves, depth {} (mean {:.1}), \
+                 {:.2} refs/prim, {:.1} prims/leaf, SAH {:.1}, {:.1} MB; validate {:.0} ms",
+                mesh.len(),
+                params.max_leaf_prims,
+                params.max_depth,
+                s.build_time.as_secs_f64() * 1e3,
+                s.nodes,
+                s.leaves,
+                s.max_depth,
+                s.mean_depth,
+                s.refs_per_prim,
+                s.mean_leaf_prims,
+                s.sah_cost,
+                s.bytes as f64 / 1e6,
+                start.elapsed().as_secs_f64() * 1e3
+            );
+        }
     }
 }
 
@@ -206,8 +240,7 @@ fn octree_bunny_builds_in_reasonable_time_and_depth() {
 #[test]
 #[ignore]
 fn octree_bunny_traversal_timing_against_bvh() {
-    let path = std::path::Path::new("/work/shared/meshes/stanford-bunny.obj");
-    let mesh = crate::mesh_io::load_mesh(path).unwrap();
+    let Some(mesh) = bunny() else { return };
     let b = Accel::<TriangleMesh>::bounds(&Octree::build(&mesh, &OctreeParams::default()));
     let mut rng = Rng(3);
     let rays: Vec<Ray> = (0..200_000)
