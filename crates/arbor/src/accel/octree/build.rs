@@ -126,12 +126,17 @@ fn partition<P: Primitives + ?Sized>(ctx: &Ctx<'_, P>, cell: &Aabb, mid: Vec3, r
     }
 }
 
-/// Whether primitive `i` goes into the (grown) cell `b`: bounds first, the exact test only for
-/// primitives that straddle the cell's faces.
+/// Whether primitive `i` goes into the (grown) cell `b`.
 #[inline]
 fn overlaps<P: Primitives + ?Sized>(ctx: &Ctx<'_, P>, i: usize, b: &Aabb) -> bool {
-    let pb = &ctx.bounds[i];
-    pb.overlaps(b) && (b.contains(pb) || ctx.prims.overlaps_box(i, b))
+    goes_into(ctx.prims, i, &ctx.bounds[i], b)
+}
+
+/// Whether primitive `i`, of bounds `pb`, goes into the grown cell `b`: bounds first, the exact test
+/// only for primitives that straddle the cell's faces.
+#[inline]
+fn goes_into<P: Primitives + ?Sized>(prims: &P, i: usize, pb: &Aabb, b: &Aabb) -> bool {
+    pb.overlaps(b) && (b.contains(pb) || prims.overlaps_box(i, b))
 }
 
 /// Whether cutting a cell of `count` references into `octants` is worth it; see the module docs.
@@ -162,9 +167,7 @@ fn flatten(cell: Cell, slot: usize, nodes: &mut Vec<Node>, refs: &mut Vec<u32>) 
     }
 }
 
-/// The same test as the build's, for `validate`.
+/// The build's test for primitive `i` and `cell` (grown by `margin`), for `validate`.
 pub(super) fn references<P: Primitives + ?Sized>(prims: &P, i: usize, cell: &Aabb, margin: f32) -> bool {
-    let b = grown(cell, margin);
-    let pb = prims.bounds(i);
-    pb.overlaps(&b) && (b.contains(&pb) || prims.overlaps_box(i, &b))
+    goes_into(prims, i, &prims.bounds(i), &grown(cell, margin))
 }

@@ -8,7 +8,7 @@
 //! Layout: one flat array of 8-byte [`Node`]s; an inner node stores the index of the first of its eight
 //! consecutive children (octant `k` has bit `a` of `k` set when it is the upper half on axis `a`), a
 //! leaf a range of [`Octree::refs`]. Cell boxes are not stored: a child's box is its parent's cut at the
-//! midpoint ([`split_point`]), computed the same way by the builder, the traversal and the checks, so
+//! midpoint (`split_point`), computed the same way by the builder, the traversal and the checks, so
 //! neighbouring cells share bit-identical faces.
 //!
 //! Invariants (checked by [`Accel::validate`], which the factory runs in debug builds):

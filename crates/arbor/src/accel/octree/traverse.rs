@@ -5,9 +5,12 @@
 //! Exactness against brute force (the same reasoning as `accel::bvh::traverse`):
 //! - a primitive reaches past its cells, so a hit found in a leaf can be beaten by a primitive met in
 //!   a later cell; it is final only when its `t` is below the cell's exit. Any closer (or equally close)
-//!   hit point lies in a cell already visited or in this one, and the primitive is referenced there.
-//!   Later cells are also skipped when their entry lies beyond the best `t`, and a leaf asks primitives
-//!   for hits up to the float just above the best `t`, so ties at equal `t` go to the lowest index;
+//!   hit point lies in a cell already visited or in this one, and the primitive is referenced there
+//!   (the build's margin keeps that true when rounding puts a reported hit a hair off the triangle).
+//!   Cells of a regular subdivision never cut one another, so the cells still on the stack begin where
+//!   this one ends. Cells are also skipped when their entry lies beyond the best `t`, and a leaf asks
+//!   primitives for hits up to the float just above the best `t`, so ties go to the lowest index;
+//! - a primitive met again in a later cell is not retested ([`Mailbox`]): its answer cannot change;
 //! - interval tests are conservative: cells are entered when their interval, widened by a slack on
 //!   both ends, is not empty, skipped only when their entry minus the slack exceeds the best `t`, and a
 //!   hit ends the query only when it is below the exit minus twice the slack. The slack covers the
@@ -188,16 +191,13 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
             if nodes[child as usize].count == 0 || !rc.visits(entry, exit, limit) {
                 continue; // an empty leaf, or not crossed
             }
-            let cell = child_box(&p.cell, mid, k);
-            {
-                let mut j = n;
-                while j > 0 && crossed[j - 1].entry < entry {
-                    crossed[j] = crossed[j - 1];
-                    j -= 1;
-                }
-                crossed[j] = Pending { node: child, cell, entry, exit };
-                n += 1;
+            let mut j = n;
+            while j > 0 && crossed[j - 1].entry < entry {
+                crossed[j] = crossed[j - 1];
+                j -= 1;
             }
+            crossed[j] = Pending { node: child, cell: child_box(&p.cell, mid, k), entry, exit };
+            n += 1;
         }
         stack[sp..sp + n].copy_from_slice(&crossed[..n]);
         sp += n;
@@ -205,7 +205,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
     best
 }
 
-/// The last primitives tested (Amanatides and Woo 1987's mailbox, as a small ring): a primitive
+/// The last primitives tested (mailboxing, Arnaldi et al. 1987, here a small ring): a primitive
 /// referenced by several cells along the ray is tested once. Skipping a repeat is exact: its hit, if
 /// any, was already weighed against a best `t` that has only decreased since.
 #[derive(Default)]

@@ -22,6 +22,10 @@ pub(super) fn validate<P: Primitives + ?Sized>(tree: &Octree, prims: &P) -> Resu
             None => Ok(()),
         };
     }
+    let union = live.iter().fold(Aabb::EMPTY, |b, &i| b.union(prims.bounds(i)));
+    if union != tree.bounds {
+        return Err(format!("bounds {:?} differ from the live primitives' {union:?}", tree.bounds));
+    }
     check_shape(tree)?;
     check_leaves(tree, prims)?;
     let first_error = live.par_iter().find_map_first(|&i| check_complete(tree, prims, i).err());
