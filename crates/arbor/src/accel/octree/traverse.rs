@@ -98,25 +98,23 @@ impl RayCells {
             let (lo, m, hi) = (t(b.min[a]), t(mid[a]), t(b.max[a]));
             *h = if self.negative[a] { [(m, lo), (hi, m)] } else { [(lo, m), (m, hi)] };
         }
-        let mut out = [(0.0f32, f32::INFINITY); 8];
-        for (k, o) in out.iter_mut().enumerate() {
-            for (a, h) in halves.iter().enumerate() {
-                let (near, far) = h[(k >> a) & 1];
-                o.0 = o.0.max(near);
-                o.1 = o.1.min(far);
-            }
-        }
-        out
+        let [x, y, z] = halves;
+        std::array::from_fn(|k| {
+            let ((nx, fx), (ny, fy), (nz, fz)) = (x[k & 1], y[(k >> 1) & 1], z[k >> 2]);
+            (0.0f32.max(nx).max(ny).max(nz), f32::INFINITY.min(fx).min(fy).min(fz))
+        })
     }
 }
 
-/// A cell waiting on the stack.
+/// A cell waiting on the stack: octant `octant` of the last cell expanded at `depth - 1` (kept in
+/// `expanded`, see [`traverse`]), which keeps entries at 16 bytes.
 #[derive(Clone, Copy)]
 struct Pending {
     node: u32,
-    cell: Aabb,
     entry: f32,
     exit: f32,
+    depth: u8,
+    octant: u8,
 }
 
 /// The closest hit in `(0, t_max)`, ties to the lowest index; with `ANY`, the first hit found (for
@@ -137,8 +135,12 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
     if !rc.visits(entry, exit, t_max) {
         return None;
     }
-    let root = Pending { node: 0, cell: tree.root, entry, exit };
+    let root = Pending { node: 0, entry, exit, depth: 0, octant: 0 };
     let mut stack = [root; STACK];
+    // The cell last expanded at each depth. Depth first, the entries on the stack above an entry of
+    // depth `d - 1` are octants of the cell expanded after it was pushed, `expanded[d - 1]`, which
+    // stays in place until they are all popped.
+    let mut expanded = [tree.root; MAX_DEPTH + 1];
     let mut sp = 1;
     let mut best: Option<Hit> = None;
     let mut limit = t_max;
@@ -155,6 +157,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
             counts.nodes += 1;
         }
         let node = nodes[p.node as usize];
+        let depth = p.depth as usize;
         if node.is_leaf() {
             for &prim in &refs[node.range()] {
                 if !mailbox.first_visit(prim) {
@@ -182,8 +185,15 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
             continue;
         }
         // Children crossed, sorted by decreasing entry so that the nearest is popped first.
-        let mid = split_point(&p.cell);
-        let intervals = rc.octant_intervals(&p.cell, mid);
+        let cell = if depth == 0 {
+            tree.root
+        } else {
+            let parent = &expanded[depth - 1];
+            child_box(parent, split_point(parent), p.octant as usize)
+        };
+        expanded[depth] = cell;
+        let mid = split_point(&cell);
+        let intervals = rc.octant_intervals(&cell, mid);
         let mut crossed = [root; 8];
         let mut n = 0;
         for (k, &(entry, exit)) in intervals.iter().enumerate() {
@@ -196,7 +206,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
                 crossed[j] = crossed[j - 1];
                 j -= 1;
             }
-            crossed[j] = Pending { node: child, cell: child_box(&p.cell, mid, k), entry, exit };
+            crossed[j] = Pending { node: child, entry, exit, depth: p.depth + 1, octant: k as u8 };
             n += 1;
         }
         stack[sp..sp + n].copy_from_slice(&crossed[..n]);
