@@ -692,3 +692,102 @@ fn bvh_variants_match_brute_force_on_adversarial_sets() {
         .collect();
     check_variants("chain", &chain, &mut rng);
 }
+
+// Octree cell faces: the generic cases rarely put geometry or rays exactly on the planes where the
+// octree cuts its cells, so here triangles lie in those planes (some duplicated: ties across cells),
+// along the lines where they cross, and rays run inside them, along their crossings, through cell
+// corners, and from far away (the traversal's slack and the build's margin are relative to the scene).
+
+const OCTREE_FACE_RAYS: usize = 4 * 25_000;
+
+/// The faces of the octree's cells down to depth 3 over `mesh`, per axis (exact `f32` coordinates).
+fn octree_faces(mesh: &TriangleMesh) -> (Aabb, [Vec<f32>; 3]) {
+    let tree =
+        arbor::accel::Octree::build(mesh, &arbor::accel::OctreeParams { max_leaf_prims: 1, ..Default::default() });
+    let mut faces: [Vec<f32>; 3] = Default::default();
+    for depth in 0..4 {
+        for b in arbor::accel::Accel::<TriangleMesh>::boxes_at_depth(&tree, depth) {
+            for (a, f) in faces.iter_mut().enumerate() {
+                f.extend([b.min[a], b.max[a]]);
+            }
+        }
+    }
+    for f in &mut faces {
+        f.sort_by(f32::total_cmp);
+        f.dedup();
+    }
+    (tree.root(), faces)
+}
+
+#[test]
+fn accel_matches_brute_force_on_octree_cell_faces() {
+    let mut rays = 0;
+    for seed in 0..4 {
+        let mut rng = Rng::new(900 + seed);
+        let mut tris = random_soup(&mut rng, 200, 20.0, 2.0);
+        let (root, faces) = octree_faces(&mesh_of(&tris));
+        let bounds = mesh_of(&tris).positions.iter().fold(Aabb::EMPTY, |b, &p| b.grow(p));
+        // A point of the scene's bounds with coordinates snapped to faces on the axes of `on`.
+        let snapped = |rng: &mut Rng, on: &[usize]| {
+            let mut p = rng.in_box(&bounds);
+            for &a in on {
+                p[a] = rng.pick(&faces[a]).clamp(bounds.min[a], bounds.max[a]);
+            }
+            p
+        };
+        for i in 0..150 {
+            let a = rng.below(3);
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            let mut t = [snapped(&mut rng, &[a]), rng.in_box(&bounds), rng.in_box(&bounds)];
+            t[1][a] = t[0][a];
+            t[2][a] = t[0][a];
+            if i % 3 == 0 {
+                // An edge along the crossing of two face planes.
+                t[1][b] = t[0][b];
+                t[1][c] = rng.in_box(&bounds)[c];
+                t[0][b] = rng.pick(&faces[b]).clamp(bounds.min[b], bounds.max[b]);
+                t[1][b] = t[0][b];
+            }
+            tris.push(t);
+            if i % 5 == 0 {
+                tris.push(t); // a tie, possibly decided in another cell than the first copy's
+            }
+        }
+        let mesh = mesh_of(&tris);
+        let (root_after, _) = octree_faces(&mesh);
+        assert_eq!(root, root_after, "the added triangles lie inside the first ones' bounds");
+        let vertices: Vec<Vec3> = tris.iter().flatten().copied().collect();
+        let targets = Targets::of(&mesh, &vertices);
+        let mut probes = targets.probes(&mut rng, 10_000);
+        for k in 0..15_000 {
+            let a = rng.below(3);
+            let (origin, dir) = match k % 5 {
+                // Inside a face plane, in any direction within it.
+                0 => {
+                    let mut d = rng.vec3() - 0.5;
+                    d[a] = if rng.below(2) == 0 { 0.0 } else { -0.0 };
+                    (snapped(&mut rng, &[a]), d)
+                }
+                // Along the crossing of two face planes.
+                1 => {
+                    let o = snapped(&mut rng, &[(a + 1) % 3, (a + 2) % 3]);
+                    (o, signed_axis(&mut rng, a))
+                }
+                // Through a cell corner.
+                2 => {
+                    let o = rng.in_box(&targets.around());
+                    (o, snapped(&mut rng, &[0, 1, 2]) - o)
+                }
+                // From far away (10 and 1000 scene sizes) at a vertex.
+                _ => {
+                    let far = if k % 5 == 3 { 10.0 } else { 1000.0 };
+                    let o = root.center() + (rng.vec3() - 0.5) * far * root.extent();
+                    (o, rng.pick(&vertices) - o)
+                }
+            };
+            probes.push(Probe { ray: Ray::new(origin, dir), t_max: f32::INFINITY });
+        }
+        rays += check("octree cell faces", &mesh, &probes);
+    }
+    assert!(rays >= OCTREE_FACE_RAYS);
+}

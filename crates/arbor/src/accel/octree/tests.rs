@@ -1,0 +1,278 @@
+//! Unit tests of the octree: structure, parameters, hostile inputs. Equality with brute force on
+//! many rays is the job of `tests/accel_conformance.rs`.
+
+use super::*;
+use crate::accel::{build_with, AccelKind, AccelSpec, BruteForce};
+use crate::geometry::TriangleMesh;
+
+/// xorshift64*: small, seeded, good enough to scatter triangles.
+struct Rng(u64);
+
+impl Rng {
+    fn f32(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn vec3(&mut self) -> Vec3 {
+        Vec3::new(self.f32(), self.f32(), self.f32())
+    }
+}
+
+fn mesh_of(tris: &[[Vec3; 3]]) -> TriangleMesh {
+    let mut mesh = TriangleMesh::default();
+    for (i, t) in tris.iter().enumerate() {
+        mesh.positions.extend_from_slice(t);
+        let k = 3 * i as u32;
+        mesh.indices.push([k, k + 1, k + 2]);
+    }
+    mesh
+}
+
+fn soup(n: usize, size: f32, seed: u64) -> TriangleMesh {
+    let mut rng = Rng(seed);
+    let tris: Vec<[Vec3; 3]> = (0..n)
+        .map(|_| {
+            let c = rng.vec3() * 10.0;
+            [c + (rng.vec3() - 0.5) * size, c + (rng.vec3() - 0.5) * size, c + (rng.vec3() - 0.5) * size]
+        })
+        .collect();
+    mesh_of(&tris)
+}
+
+fn assert_matches_brute(mesh: &TriangleMesh, tree: &Octree, rays: usize, seed: u64) {
+    let brute = BruteForce::build(mesh);
+    let mut rng = Rng(seed);
+    for _ in 0..rays {
+        let ray = Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5);
+        let expected = brute.intersect(mesh, &ray, f32::INFINITY);
+        assert_eq!(tree.intersect(mesh, &ray, f32::INFINITY), expected, "ray {ray:?}");
+        let mut counts = TraversalCounts::default();
+        assert_eq!(tree.intersect_counted(mesh, &ray, f32::INFINITY, &mut counts), expected);
+        assert!(counts.prims > 0 || expected.is_none());
+        assert_eq!(tree.occluded(mesh, &ray, 5.0), brute.occluded(mesh, &ray, 5.0));
+    }
+}
+
+#[test]
+fn octree_empty_set_hits_nothing() {
+    let mesh = TriangleMesh::default();
+    let tree = Octree::build(&mesh, &OctreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let ray = Ray::new(Vec3::ZERO, Vec3::X);
+    assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), None);
+    assert!(!tree.occluded(&mesh, &ray, f32::INFINITY));
+    assert!(Accel::<TriangleMesh>::bounds(&tree).is_empty());
+    assert_eq!(Accel::<TriangleMesh>::stats(&tree).nodes, 0);
+    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0).is_empty());
+}
+
+#[test]
+fn octree_matches_brute_force_on_random_soups() {
+    for (size, seed) in [(0.5, 1), (3.0, 2), (12.0, 3)] {
+        let mesh = soup(2000, size, seed);
+        let tree = Octree::build(&mesh, &OctreeParams::default());
+        tree.validate(&mesh).unwrap();
+        assert_matches_brute(&mesh, &tree, 3000, seed + 10);
+    }
+}
+
+#[test]
+fn octree_references_a_triangle_on_a_split_plane_on_both_sides() {
+    // Many small triangles to force splits, and one lying exactly in the root's mid plane x = 5.
+    let mut tris: Vec<[Vec3; 3]> = (0..200)
+        .map(|i| {
+            let p = Vec3::new((i % 10) as f32, ((i / 10) % 10) as f32, (i / 100) as f32 * 10.0);
+            [p, p + Vec3::X * 0.3, p + Vec3::Y * 0.3]
+        })
+        .collect();
+    let mid = split_point(&Octree::build(&mesh_of(&tris), &OctreeParams::default()).root()).x;
+    // Inside the other triangles' bounds, so the root does not move.
+    tris.push([Vec3::new(mid, 2.0, 2.0), Vec3::new(mid, 7.0, 2.0), Vec3::new(mid, 2.0, 7.0)]);
+    let mesh = mesh_of(&tris);
+    let tree = Octree::build(&mesh, &OctreeParams { max_leaf_prims: 2, ..Default::default() });
+    tree.validate(&mesh).unwrap();
+    assert_eq!(split_point(&tree.root()).x, mid);
+    let last = (tris.len() - 1) as u32;
+    let (mut below, mut above) = (false, false);
+    tree.for_each_cell(|node, cell, _| {
+        if node.is_leaf() && tree.refs()[node.range()].contains(&last) {
+            below |= cell.max.x == mid;
+            above |= cell.min.x == mid;
+        }
+    });
+    assert!(below && above, "referenced on one side only");
+    for dir in [Vec3::X, -Vec3::X] {
+        let ray = Ray::new(Vec3::new(mid, 3.0, 3.0) - 3.0 * dir, dir);
+        assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim), Some(last));
+    }
+}
+
+#[test]
+fn octree_stops_splitting_coincident_triangles() {
+    let big = [Vec3::ZERO, Vec3::new(10.0, 0.0, 3.0), Vec3::new(0.0, 10.0, 7.0)];
+    let mesh = mesh_of(&vec![big; 500]);
+    let tree = Octree::build(&mesh, &OctreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let stats = Accel::<TriangleMesh>::stats(&tree);
+    assert!(stats.nodes <= 9 && stats.refs_per_prim <= 8.0, "{stats:?}");
+    let ray = Ray::new(Vec3::new(1.0, 1.0, -5.0), Vec3::Z);
+    assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY).map(|h| h.prim), Some(0));
+}
+
+#[test]
+fn octree_leaves_out_non_finite_primitives() {
+    let ok = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let inf = [Vec3::ZERO, Vec3::splat(f32::INFINITY), Vec3::Y];
+    let mesh = mesh_of(&[inf, ok, inf]);
+    let tree = Octree::build(&mesh, &OctreeParams::default());
+    tree.validate(&mesh).unwrap();
+    assert_eq!(tree.refs(), &[1]);
+    assert_eq!(Accel::<TriangleMesh>::bounds(&tree), Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
+}
+
+#[test]
+fn octree_params_parse_clamp_and_presets_differ() {
+    let spec = AccelSpec::new(AccelKind::Octree).with_params(["leaf=3", "depth=99", "traversal-cost=2"]).unwrap();
+    let p: OctreeParams = spec.parse().unwrap();
+    assert_eq!((p.max_leaf_prims, p.max_depth, p.traversal_cost), (3, 99, 2.0));
+    assert_eq!(p.sanitized().max_depth, MAX_DEPTH);
+    let bad = AccelSpec::new(AccelKind::Octree).with_params(["bins=3"]).unwrap();
+    assert!(bad.parse::<OctreeParams>().unwrap_err().contains("no parameter 'bins'"));
+    let mesh = soup(3000, 0.3, 5);
+    let shallow = Accel::<TriangleMesh>::stats(&Octree::build(&mesh, &OctreeParams::fast_build()));
+    let deep = Accel::<TriangleMesh>::stats(&Octree::build(&mesh, &OctreeParams::quality()));
+    assert!(shallow.nodes < deep.nodes && shallow.max_depth <= 8, "{shallow:?} {deep:?}");
+    let one = Octree::build(&mesh, &OctreeParams { max_depth: 1, ..Default::default() });
+    assert_eq!(Accel::<TriangleMesh>::stats(&one).max_depth, 1);
+    assert!(build_with(&spec, &mesh).is_ok());
+}
+
+#[test]
+fn octree_stats_and_boxes_describe_the_tree() {
+    let mesh = soup(5000, 0.4, 9);
+    let tree = Octree::build(&mesh, &OctreeParams::default());
+    let s = Accel::<TriangleMesh>::stats(&tree);
+    assert_eq!((s.kind, s.primitives, s.nodes), ("octree", 5000, tree.nodes().len()));
+    assert!(s.leaves > 0 && s.max_depth >= 3 && s.mean_depth > 1.0 && s.mean_depth <= s.max_depth as f64);
+    assert!(s.refs_per_prim >= 1.0 && s.mean_leaf_prims > 0.0 && s.sah_cost > 0.0 && s.bytes > 0);
+    assert_eq!((s.nodes - 1) % 8, 0);
+    let root = tree.root();
+    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0), vec![root]);
+    let level1 = Accel::<TriangleMesh>::boxes_at_depth(&tree, 1);
+    assert!(!level1.is_empty() && level1.len() <= 8);
+    assert!(level1.iter().all(|b| root.contains(b)));
+    let e = root.extent();
+    assert!((e.x - e.y).abs() <= 1e-5 * e.x && (e.x - e.z).abs() <= 1e-5 * e.x, "root is a cube");
+}
+
+#[test]
+fn octree_build_is_deterministic() {
+    let mesh = soup(20_000, 0.3, 4);
+    let a = Octree::build(&mesh, &OctreeParams::default());
+    let b = Octree::build(&mesh, &OctreeParams::default());
+    assert_eq!((a.nodes(), a.refs()), (b.nodes(), b.refs()));
+}
+
+#[test]
+fn octree_validate_catches_a_missing_reference() {
+    let mesh = soup(500, 0.5, 6);
+    let mut tree = Octree::build(&mesh, &OctreeParams::default());
+    tree.validate(&mesh).unwrap();
+    let leaf = tree.nodes.iter().position(|n| n.is_leaf() && n.count > 1).unwrap();
+    let r = tree.nodes[leaf].range();
+    tree.refs[r.start] = tree.refs[r.start + 1];
+    assert!(tree.validate(&mesh).is_err());
+}
+
+/// A mesh from `$ARBOR_MESHES` or `../shared/meshes` beside the checkout, if present.
+fn shared_mesh(name: &str) -> Option<TriangleMesh> {
+    let dir = std::env::var_os("ARBOR_MESHES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes"));
+    let path = dir.join(name);
+    let mesh = crate::mesh_io::load_mesh(&path);
+    if mesh.is_err() {
+        eprintln!("SKIPPED: {} not loaded", path.display());
+    }
+    mesh.ok()
+}
+
+fn bunny() -> Option<TriangleMesh> {
+    shared_mesh("stanford-bunny.obj")
+}
+
+/// Build numbers of the report, on the shared meshes with the three presets:
+/// `cargo test -p arbor --lib octree_real_meshes -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn octree_real_meshes_build_in_reasonable_time_and_depth() {
+    for name in ["stanford-bunny.obj", "horse.ply", "igea.ply", "nefertiti.obj", "ogre.obj"] {
+        let Some(mesh) = shared_mesh(name) else { continue };
+        for params in [OctreeParams::default(), OctreeParams::fast_build(), OctreeParams::quality()] {
+            let tree = Octree::build(&mesh, &params);
+            let s = Accel::<TriangleMesh>::stats(&tree);
+            let start = std::time::Instant::now();
+            tree.validate(&mesh).unwrap();
+            println!(
+                "{name} {} tris, leaf {} depth {}: build {:.0} ms, {} nodes, {} leaves, depth {} (mean {:.1}), \
+                 {:.2} refs/prim, {:.1} prims/leaf, SAH {:.1}, {:.1} MB; validate {:.0} ms",
+                mesh.len(),
+                params.max_leaf_prims,
+                params.max_depth,
+                s.build_time.as_secs_f64() * 1e3,
+                s.nodes,
+                s.leaves,
+                s.max_depth,
+                s.mean_depth,
+                s.refs_per_prim,
+                s.mean_leaf_prims,
+                s.sah_cost,
+                s.bytes as f64 / 1e6,
+                start.elapsed().as_secs_f64() * 1e3
+            );
+        }
+    }
+}
+
+/// A one-off timing against the SAH BVH on the same rays (not a benchmark: `arbor bench` is).
+#[test]
+#[ignore]
+fn octree_bunny_traversal_timing_against_bvh() {
+    let Some(mesh) = bunny() else { return };
+    let b = Accel::<TriangleMesh>::bounds(&Octree::build(&mesh, &OctreeParams::default()));
+    let mut rng = Rng(3);
+    let rays: Vec<Ray> = (0..200_000)
+        .map(|_| {
+            let o = b.center() + (rng.vec3() - 0.5) * 3.0 * b.extent();
+            let target = b.min + rng.vec3() * b.extent();
+            Ray::new(o, target - o)
+        })
+        .collect();
+    let specs = [
+        ("octree", vec![]),
+        ("octree", vec!["leaf=16", "depth=8"]),
+        ("octree", vec!["leaf=4", "depth=12"]),
+        ("bvh-sah", vec![]),
+    ];
+    for (kind, params) in specs {
+        let spec = AccelSpec::new(kind.parse().unwrap()).with_params(params.iter().copied()).unwrap();
+        let accel = build_with(&spec, &mesh).unwrap();
+        let kind = format!("{kind} {params:?}");
+        let mut counts = TraversalCounts::default();
+        for r in &rays {
+            accel.intersect_counted(&mesh, r, f32::INFINITY, &mut counts);
+        }
+        let start = std::time::Instant::now();
+        let hits = rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count();
+        let secs = start.elapsed().as_secs_f64();
+        let n = rays.len() as f64;
+        println!(
+            "{kind}: {:.2} Mrays/s, {hits} hits, {:.1} nodes/ray, {:.1} prims/ray",
+            n / secs / 1e6,
+            counts.nodes as f64 / n,
+            counts.prims as f64 / n
+        );
+    }
+}
