@@ -29,6 +29,16 @@ pub use kdtree::{KdTree, KdTreeParams};
 pub use octree::{Octree, OctreeParams};
 pub use params::{AccelSpec, Params};
 
+/// How much every structure widens its box and interval tests, relative to the extent in `t` of the box
+/// (or root) along the ray's major axis: 2^-16, about 128 ulps.
+///
+/// Why: the watertight triangle test computes `t` as a barycentric blend of the corners' distances
+/// along the major axis, so the error of a reported `t` scales with the triangle's extent along the ray,
+/// not with `t`, and can put a hit slightly outside the box or cell that holds the triangle. Pruning on
+/// an exact interval could then lose the closest hit, or a tie's winner, relative to brute force.
+/// `bvh/traverse.rs` argues the bound in full; the conformance suite fails with 16 times less.
+pub(crate) const BOX_SLACK: f32 = 1.0 / 65_536.0;
+
 /// A hit on one primitive, before its index is known.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PrimHit {

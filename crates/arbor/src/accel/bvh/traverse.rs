@@ -25,9 +25,8 @@ use super::{Node, MAX_DEPTH};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
-/// Slack of the box test, relative to the box's extent in `t` along the ray's major axis (2^-16, about
-/// 128 ulps); see the module docs.
-const SLACK: f32 = 1.0 / 65_536.0;
+/// The shared slack of box and interval tests ([`crate::accel::BOX_SLACK`]).
+const SLACK: f32 = crate::accel::BOX_SLACK;
 
 /// A ray prepared for slab tests.
 struct RayBoxTest {

@@ -27,8 +27,8 @@ use super::{KdTree, MAX_DEPTH};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
-/// Margin relative to the root box's extent in `t` along the ray's major axis (2^-16); see above.
-const SLACK: f32 = 1.0 / 65_536.0;
+/// The shared slack of box and interval tests ([`crate::accel::BOX_SLACK`]).
+const SLACK: f32 = crate::accel::BOX_SLACK;
 
 /// A node still to visit and the part of the ray inside it.
 #[derive(Debug, Clone, Copy, Default)]

@@ -30,9 +30,8 @@ use super::{child_box, split_point, Octree, MAX_DEPTH};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
-/// Slack of the interval tests, relative to the root's extent in `t` along the ray's major axis
-/// (2^-16); see the module docs.
-const SLACK: f32 = 1.0 / 65_536.0;
+/// The shared slack of box and interval tests ([`crate::accel::BOX_SLACK`]).
+const SLACK: f32 = crate::accel::BOX_SLACK;
 
 /// Deepest stack: each inner level pops one cell and pushes at most eight, and leaves are at depth
 /// [`MAX_DEPTH`] at most, so `1 + 7 * MAX_DEPTH` entries.
