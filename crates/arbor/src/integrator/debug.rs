@@ -285,7 +285,7 @@ fn draw_line(film: &mut Film, p: [f64; 2], q: [f64; 2], color: Color) {
             }
         }
     }
-    if !(t0 <= t1) {
+    if t0 > t1 {
         return;
     }
     let a = [p[0] + t0 * d[0], p[1] + t0 * d[1]];
