@@ -51,6 +51,9 @@ fn debug_primid_identical_across_structures_on_generated_mesh() {
         let (film, _) = debug_render(&desc, kind, DebugView::PrimId);
         assert!(film.to_rgb8() == bytes, "{kind}: primid image differs from bvh-sah's");
     }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let (alone, _) = pool.install(|| debug_render(&desc, AccelKind::BvhSah, DebugView::PrimId));
+    assert!(alone.to_rgb8() == bytes, "primid image depends on the thread count");
 }
 
 fn scene_files(dir: &Path, ext: &str) -> Vec<PathBuf> {
