@@ -121,6 +121,7 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     let prims = reference.geometry.counts.triangles + reference.geometry.counts.spheres;
     drop(reference);
 
+    eprintln!("bench: tracing a sample with brute force");
     let brute_max = args.brute_rays.map_or((BRUTE_BUDGET / prims.max(1)).clamp(64, 4096), |n| n as usize);
     let brute_scene = Scene::build(desc.clone(), &AccelSpec::new(AccelKind::Brute), None)?;
     let brute: Vec<SetResult> = sets.iter().map(|s| measure(&brute_scene, s, Some(brute_max), args.runs)).collect();
@@ -134,6 +135,8 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
             rows.push((AccelStats { kind: spec.kind.name(), ..brute_stats.clone() }, again));
             continue;
         }
+        // Progress on standard error: a slow structure should not look like a hang.
+        eprintln!("bench: tracing with {}", spec.kind);
         let scene = Scene::build(desc.clone(), spec, None)?;
         let results = sets.iter().map(|s| measure(&scene, s, None, args.runs)).collect();
         // Named by what was asked for: a structure may report another's name while it delegates.
