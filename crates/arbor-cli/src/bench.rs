@@ -238,7 +238,10 @@ fn measure_again(brute: &[SetResult], set: &RaySet) -> SetResult {
 }
 
 fn fmt_rate(x: f64) -> String {
-    if x.is_finite() {
+    if x.is_finite() && x < 0.01 {
+        // Brute force on big meshes: keep significant digits.
+        format!("{x:.2e}")
+    } else if x.is_finite() {
         format!("{x:.3}")
     } else {
         "-".into()
