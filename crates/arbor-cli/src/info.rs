@@ -109,16 +109,13 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         g.mesh_load.as_secs_f64() * 1e3
     );
     let s = scene.geometry.accel_stats();
+    say!("structure  {} over {} primitives, built in {:.1} ms", s.kind, s.primitives, s.build_time.as_secs_f64() * 1e3);
+    say!("           {} nodes, {} leaves; leaf depth max {}, mean {:.2}", s.nodes, s.leaves, s.max_depth, s.mean_depth);
     say!(
-        "structure  {}: {} nodes, {} leaves, max depth {}, {:.2} primitives per leaf, SAH cost {:.2}, {} KiB, built in {:.1} ms",
-        s.kind,
-        s.nodes,
-        s.leaves,
-        s.max_depth,
+        "           {:.2} primitives per non-empty leaf, {:.3} references per primitive",
         s.mean_leaf_prims,
-        s.sah_cost,
-        s.bytes / 1024,
-        s.build_time.as_secs_f64() * 1e3
+        s.refs_per_prim
     );
+    say!("           SAH cost {:.2}, {:.1} KiB", s.sah_cost, s.bytes as f64 / 1024.0);
     Ok(())
 }

@@ -1,4 +1,4 @@
-//! `arbor`: render scene files, describe them, compare images.
+//! `arbor`: render scene files, describe them, benchmark their acceleration structures, compare images.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
 //! 4 I/O failure.
@@ -9,6 +9,7 @@ macro_rules! say {
     ($($arg:tt)*) => { $crate::say_line(format_args!($($arg)*)) };
 }
 
+mod bench;
 mod diff;
 mod info;
 mod render;
@@ -32,6 +33,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Describe a scene: cameras, lights, materials, objects, triangle counts, structure statistics.
     Info(info::InfoArgs),
+    /// Benchmark the acceleration structures on a scene, a mesh file or a generated sphere: one row per
+    /// structure with build statistics, Mrays/s and speedup over brute force; checks every structure's
+    /// hits against the default one's (any difference: exit 3).
+    Bench(bench::BenchArgs),
     /// Compare an image with a reference: PSNR and the share of pixels off by more than a threshold.
     Diff(diff::DiffArgs),
 }
@@ -82,6 +87,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Info(args) => info::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
     };
     match result {

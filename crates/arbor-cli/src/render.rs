@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use arbor::accel::{AccelKind, AccelSpec};
+use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, RenderOptions};
 use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
@@ -47,6 +48,11 @@ pub struct RenderArgs {
     /// Never cull back faces, even when the scene asks for it.
     #[arg(long)]
     pub no_cull: bool,
+    /// A debug view instead of the image: boxes[:DEPTH] (the structure's boxes at DEPTH, default 3, as
+    /// wireframe over the render), heatmap (nodes visited + primitives tested per pixel, false colour,
+    /// legend along the bottom, maximum printed), primid (a colour per primitive), normal.
+    #[arg(long, value_name = "VIEW")]
+    pub debug: Option<DebugView>,
     /// Render only the camera with this id.
     #[arg(long)]
     pub camera: Option<String>,
@@ -118,6 +124,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         } else {
             None
         },
+        debug: args.debug,
     };
     for &c in &cameras {
         let cam = &scene.desc.cameras[c];
@@ -145,6 +152,20 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
                 stats.rays as f64 / 1e6,
                 stats.mrays_per_s()
             );
+            let s = scene.geometry.accel_stats();
+            say!(
+                "  structure {}: {} nodes, {} leaves, depth max {} mean {:.1}{}",
+                s.kind,
+                s.nodes,
+                s.leaves,
+                s.max_depth,
+                s.mean_depth,
+                args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
+            );
+        }
+        if let Some(max) = stats.heatmap_max {
+            // Printed even with --quiet: without it the heatmap's colours have no scale.
+            say!("heatmap maximum {max} (nodes visited + primitives tested) for {}", path.display());
         }
     }
     Ok(())

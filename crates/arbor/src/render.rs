@@ -1,5 +1,8 @@
 //! Rendering one camera's image: 16x16 tiles traced in parallel over rayon. Each pixel sample draws from
 //! its own random stream ([`crate::sampler`]), so the image does not depend on thread count or tile order.
+//!
+//! A debug view ([`RenderOptions::debug`]) either replaces the Whitted integrator by one ray through each
+//! pixel centre ([`DebugIntegrator`]), or draws over the finished Whitted image (boxes).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -8,7 +11,8 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::film::Film;
-use crate::integrator::Whitted;
+use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
+use crate::integrator::{DebugIntegrator, DebugView, Whitted};
 use crate::math::Color;
 use crate::sampler::{pixel_offset, Rng};
 use crate::scene::Scene;
@@ -22,6 +26,8 @@ pub struct RenderOptions {
     pub spp: Option<u32>,
     /// Cull back faces for camera rays; `None` follows the scene (which defaults to no culling).
     pub cull_backfaces: Option<bool>,
+    /// Render a debug view instead of (or over) the Whitted image.
+    pub debug: Option<DebugView>,
 }
 
 /// What a render measured.
@@ -33,6 +39,8 @@ pub struct RenderStats {
     pub time: Duration,
     /// Samples per pixel used.
     pub spp: u32,
+    /// The heatmap view's largest per-pixel cost (nodes visited plus primitives tested).
+    pub heatmap_max: Option<u32>,
 }
 
 impl RenderStats {
@@ -53,16 +61,18 @@ pub fn render(
     let start = Instant::now();
     let desc = &scene.desc.cameras[camera];
     let cam = Camera::new(desc);
-    let spp = opts.spp.unwrap_or(desc.num_samples).max(1);
     let cull = opts.cull_backfaces.or(scene.desc.cull_backfaces).unwrap_or(false);
     let integrator = Whitted::new(scene, cull);
+    // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
+    let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
+    let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(desc.num_samples).max(1) };
     let (w, h) = (cam.width, cam.height);
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let total = w as u64 * h as u64;
     let done = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
-    let scale = scene.desc.radiance_scale;
+    let scale = if debug.is_some() { 1.0 } else { scene.desc.radiance_scale };
 
     let rendered: Vec<((u32, u32), Vec<Color>)> = tiles
         .par_iter()
@@ -77,7 +87,13 @@ pub fn render(
                         let mut rng = Rng::for_sample(x, y, k);
                         let offset = pixel_offset(k, spp, &mut rng);
                         let ray = cam.ray(x, y, offset, rng.next_2d());
-                        sum += integrator.li_camera(&ray, &mut rng, &mut count);
+                        sum += match &debug {
+                            Some(d) => {
+                                count += 1;
+                                d.li_camera(&ray)
+                            }
+                            None => integrator.li_camera(&ray, &mut rng, &mut count),
+                        };
                     }
                     pixels.push(sum * (scale / spp as f32));
                 }
@@ -97,6 +113,14 @@ pub fn render(
             film.pixels[y * w as usize + x] = c;
         }
     }
-    let stats = RenderStats { rays: rays.into_inner(), time: start.elapsed(), spp };
+    let heatmap_max = match opts.debug {
+        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
+        Some(DebugView::Boxes { depth }) => {
+            overlay_boxes(&mut film, desc, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
+            None
+        }
+        _ => None,
+    };
+    let stats = RenderStats { rays: rays.into_inner(), time: start.elapsed(), spp, heatmap_max };
     (film, stats)
 }
