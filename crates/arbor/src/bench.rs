@@ -159,7 +159,7 @@ pub fn mismatches(a: &[Option<Hit>], b: &[Option<Hit>]) -> usize {
         .zip(b)
         .filter(|(x, y)| match (x, y) {
             (None, None) => false,
-            (Some(x), Some(y)) => x.prim != y.prim || x.t.to_bits() != y.t.to_bits(),
+            (Some(x), Some(y)) => (x.prim, x.sub) != (y.prim, y.sub) || x.t.to_bits() != y.t.to_bits(),
             _ => true,
         })
         .count()
@@ -211,7 +211,9 @@ mod tests {
         let rays = vec![Ray::new(Vec3::ZERO, Vec3::X); 10];
         let (kept, k) = sample(&rays, 3);
         assert_eq!((kept.len(), k), (3, 4));
-        let h = |t: f32, prim| Some(Hit { t, prim, u: 0.0, v: 0.0 });
-        assert_eq!(mismatches(&[h(1.0, 1), None, h(2.0, 3)], &[h(1.0, 1), h(1.0, 1), h(2.0, 4)]), 2);
+        let h = |t: f32, prim, sub| Some(Hit { t, prim, u: 0.0, v: 0.0, sub });
+        let a = [h(1.0, 1, 0), None, h(2.0, 3, 0), h(3.0, 0, 5)];
+        let b = [h(1.0, 1, 0), h(1.0, 1, 0), h(2.0, 4, 0), h(3.0, 0, 6)];
+        assert_eq!(mismatches(&a, &b), 3, "another triangle of the same mesh is a mismatch");
     }
 }

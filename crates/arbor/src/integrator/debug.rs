@@ -106,7 +106,9 @@ impl<'a> DebugIntegrator<'a> {
                 geometry.intersect_counted(&ray, f32::INFINITY, &mut counts);
                 Color::new(counts.nodes as f32 + counts.prims as f32, 0.0, 0.0)
             }
-            DebugView::PrimId => geometry.intersect(&ray, f32::INFINITY).map_or(Color::ZERO, |h| prim_color(h.prim)),
+            DebugView::PrimId => {
+                geometry.intersect(&ray, f32::INFINITY).map_or(Color::ZERO, |h| prim_color(geometry.global_prim_id(&h)))
+            }
             DebugView::Normal | DebugView::Boxes { .. } => match geometry.intersect(&ray, f32::INFINITY) {
                 Some(h) => self.scene.surface(&ray, &h).ns * 0.5 + Color::splat(0.5),
                 None => Color::ZERO,

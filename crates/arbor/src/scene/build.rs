@@ -207,13 +207,10 @@ impl SceneGeometry {
         }
     }
 
-    /// The world-space boxes of the nodes at `depth` of every mesh's structure, and of the top-level
-    /// structure's when the scene has more than one object (the boxes debug view).
+    /// The world-space boxes of the nodes at `depth` of the top-level structure and of every mesh's
+    /// structure (the boxes debug view).
     pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
-        let mut out = Vec::new();
-        if self.objects.len() > 1 {
-            out.extend(self.top.boxes_at_depth(depth));
-        }
+        let mut out = self.top.boxes_at_depth(depth);
         for o in &self.objects.objects {
             if let Shape::Mesh(m) = &o.shape {
                 let boxes = m.accel.boxes_at_depth(depth);
