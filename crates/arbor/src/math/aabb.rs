@@ -70,6 +70,16 @@ impl Aabb {
         let e = self.extent();
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
+    /// Surface area in double precision, so that boxes near the float range do not overflow to infinity
+    /// (0 for an empty box).
+    #[inline]
+    pub fn area_f64(&self) -> f64 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let e = self.max.as_dvec3() - self.min.as_dvec3();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
     /// Index of the longest axis.
     #[inline]
     pub fn longest_axis(&self) -> usize {

@@ -19,7 +19,7 @@
 
 use rayon::prelude::*;
 
-use super::{area_f64, BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
+use super::{BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
 use crate::accel::Primitives;
 use crate::math::{Aabb, Vec3};
 
@@ -189,11 +189,11 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
     for k in (1..nb).rev() {
         b = b.union(boxes[k]);
         c += counts[k];
-        right_cost[k - 1] = c as f64 * area_f64(&b);
+        right_cost[k - 1] = c as f64 * b.area_f64();
     }
     // A node of zero area (primitives on a line) makes every plane cost the same; the first one with
     // primitives on both sides wins, and that is all a degenerate node needs.
-    let area = area_f64(bounds);
+    let area = bounds.area_f64();
     let inv_area = if area > 0.0 { 1.0 / area } else { 0.0 };
     let (mut b, mut c) = (Aabb::EMPTY, 0usize);
     let mut best = (0usize, f64::INFINITY);
@@ -204,7 +204,7 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
             continue;
         }
         let cost = params.traversal_cost as f64
-            + params.intersection_cost as f64 * (c as f64 * area_f64(&b) + right_cost[k]) * inv_area;
+            + params.intersection_cost as f64 * (c as f64 * b.area_f64() + right_cost[k]) * inv_area;
         if cost < best.1 {
             best = (k, cost);
         }

@@ -257,10 +257,10 @@ impl Bvh {
         };
         // Areas relative to the root's; a root of zero area (all primitives on one line or point)
         // makes every node equally likely to be visited.
-        let root_area = area_f64(&root.bounds());
+        let root_area = root.bounds().area_f64();
         let rel = |n: &Node| {
             if root_area > 0.0 {
-                area_f64(&n.bounds()) / root_area
+                n.bounds().area_f64() / root_area
             } else {
                 1.0
             }
@@ -287,15 +287,6 @@ impl Bvh {
         stats.refs_per_prim = if stats.primitives > 0 { leaf_prims as f64 / stats.primitives as f64 } else { 0.0 };
         stats
     }
-}
-
-/// Surface area in double precision, so that boxes near the float range do not overflow to infinity.
-fn area_f64(b: &Aabb) -> f64 {
-    if b.is_empty() {
-        return 0.0;
-    }
-    let e = b.max.as_dvec3() - b.min.as_dvec3();
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
 impl<P: Primitives + ?Sized> Accel<P> for Bvh {

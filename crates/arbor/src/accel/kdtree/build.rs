@@ -17,7 +17,7 @@
 //!
 //! Events carry `-0.0` folded into `+0.0`, so equal positions are equal bit patterns for sorting.
 
-use super::{area_f64, split_box, KdTreeParams, Node};
+use super::{split_box, KdTreeParams, Node};
 use crate::accel::Primitives;
 use crate::math::Aabb;
 
@@ -133,7 +133,7 @@ fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
 
 /// The cheapest split of a node with box `bx` and `n` primitives, if it beats making a leaf.
 fn find_split(events: &Events, bx: &Aabb, n: usize, params: &KdTreeParams) -> Option<Split> {
-    let area = area_f64(bx);
+    let area = bx.area_f64();
     if !(area > 0.0 && area.is_finite()) {
         return None;
     }
@@ -170,7 +170,7 @@ fn find_split(events: &Events, bx: &Aabb, n: usize, params: &KdTreeParams) -> Op
 /// planar ones put on whichever side is cheaper (left on ties).
 fn sah(bx: &Aabb, area: f64, axis: usize, pos: f32, [left, planar, right]: [usize; 3], params: &KdTreeParams) -> Split {
     let (below, above) = split_box(bx, axis, pos);
-    let (pl, pr) = (area_f64(&below) / area, area_f64(&above) / area);
+    let (pl, pr) = (below.area_f64() / area, above.area_f64() / area);
     let (kt, ki) = (params.traversal_cost as f64, params.intersection_cost as f64);
     let bonus = 1.0 - params.empty_bonus as f64;
     let cost = |l: usize, r: usize| {

@@ -241,11 +241,11 @@ impl KdTree {
             build_time,
             ..AccelStats::default()
         };
-        let root_area = area_f64(&self.bounds);
+        let root_area = self.bounds.area_f64();
         let (mut refs, mut depth_sum, mut non_empty) = (0usize, 0usize, 0usize);
         self.walk(|_, n, b, depth| {
             // A flat or degenerate root makes every node equally likely to be visited.
-            let p = if root_area > 0.0 { area_f64(b) / root_area } else { 1.0 };
+            let p = if root_area > 0.0 { b.area_f64() / root_area } else { 1.0 };
             if n.is_leaf() {
                 stats.leaves += 1;
                 stats.max_depth = stats.max_depth.max(depth);
@@ -326,15 +326,6 @@ fn split_box(b: &Aabb, axis: usize, split: f32) -> (Aabb, Aabb) {
     below.max[axis] = split;
     above.min[axis] = split;
     (below, above)
-}
-
-/// Surface area in double precision, so that boxes near the float range do not overflow to infinity.
-fn area_f64(b: &Aabb) -> f64 {
-    if b.is_empty() {
-        return 0.0;
-    }
-    let e = b.max.as_dvec3() - b.min.as_dvec3();
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
 impl<P: Primitives + ?Sized> Accel<P> for KdTree {

@@ -17,7 +17,7 @@
 
 use super::{Cluster, NO_CHILD};
 use crate::accel::bvh::build::{make_leaf, BuildNode, BuildPrim};
-use crate::accel::bvh::{area_f64, median, BvhParams, MAX_DEPTH, MAX_SAH_DEPTH};
+use crate::accel::bvh::{median, BvhParams, MAX_DEPTH, MAX_SAH_DEPTH};
 use crate::math::Aabb;
 
 /// What the collapsing pass decided for each arena node.
@@ -43,7 +43,7 @@ fn plan(arena: &[Cluster], max_leaf: usize) -> Plan {
     let (mut count, mut cost) = (vec![1usize; n], vec![0.0f64; n]);
     let mut plan = Plan { collapse: vec![true; n], height: vec![0; n] };
     for (i, c) in arena.iter().enumerate() {
-        let area = area_f64(&c.bounds);
+        let area = c.bounds.area_f64();
         if c.is_leaf() {
             cost[i] = ci * area;
             continue;

@@ -25,7 +25,7 @@ mod ploc;
 mod tests;
 
 use super::build::{finish, split_live};
-use super::{area_f64, Node, LEAF_HARD_MAX};
+use super::{Node, LEAF_HARD_MAX};
 use crate::accel::params::{parse_value, unknown_key, Params};
 use crate::accel::Primitives;
 use crate::math::Aabb;
@@ -174,7 +174,7 @@ fn merge(arena: &mut Vec<Cluster>, a: u32, b: u32) -> u32 {
 #[inline]
 fn merge_cost(cost: MergeCost, a: &Aabb, b: &Aabb) -> f64 {
     match cost {
-        MergeCost::Area => area_f64(&a.union(*b)),
+        MergeCost::Area => a.union(*b).area_f64(),
         MergeCost::Volume => {
             let u = a.union(*b);
             let e = u.max.as_dvec3() - u.min.as_dvec3();

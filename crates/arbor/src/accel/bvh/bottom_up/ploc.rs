@@ -20,7 +20,6 @@
 use rayon::prelude::*;
 
 use super::{merge, Cluster};
-use crate::accel::bvh::area_f64;
 use crate::accel::bvh::build::BuildPrim;
 use crate::math::{Aabb, Vec3};
 
@@ -56,7 +55,7 @@ fn nearest(boxes: &[Aabb], i: usize, radius: usize) -> usize {
     let (lo, hi) = (i.saturating_sub(radius), (i + radius + 1).min(boxes.len()));
     let mut best = (f64::INFINITY, usize::MAX);
     for j in (lo..hi).filter(|&j| j != i) {
-        let a = area_f64(&boxes[i].union(boxes[j]));
+        let a = boxes[i].union(boxes[j]).area_f64();
         if best.1 == usize::MAX || a < best.0 {
             best = (a, j);
         }
