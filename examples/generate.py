@@ -176,7 +176,7 @@ def torus_knot(p=2, q=3, nu=256, nv=16, R=2.0, r=0.45, tube=0.35):
         for j in range(nv):
             a, b = i * nv + j, ((i + 1) % nu) * nv + j
             c, d = ((i + 1) % nu) * nv + (j + 1) % nv, i * nv + (j + 1) % nv
-            faces += [(a, b, c), (a, c, d)]
+            faces += [(a, c, b), (a, d, c)]  # counter-clockwise around the outward normals
     return verts, norms, faces
 
 
