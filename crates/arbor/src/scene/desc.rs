@@ -26,6 +26,8 @@ pub struct SceneDesc {
     pub intersection_epsilon: f32,
     /// Bounces of mirror, conductor and dielectric rays; 0 means none.
     pub max_depth: u32,
+    /// Where the file sets `max_depth` (`MaxRecursionDepth`), for the limit check's message.
+    pub max_depth_loc: Option<Location>,
     /// Whether lights are tested for occlusion. The NYU assignment-4 renderer shades without shadow rays.
     pub shadows: bool,
     /// The scene's own back-face culling choice for primary rays (`BackfaceCulling`), if it makes one.
@@ -57,6 +59,7 @@ impl SceneDesc {
             shadow_epsilon: 1e-3,
             intersection_epsilon: 1e-6,
             max_depth: 0,
+            max_depth_loc: None,
             shadows: true,
             cull_backfaces: None,
             cameras: Vec::new(),

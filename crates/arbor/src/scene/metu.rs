@@ -197,6 +197,7 @@ impl Reader<'_> {
         }
         if let Some(n) = self.one(root, "MaxRecursionDepth") {
             self.desc.max_depth = n.uint(p)?;
+            self.desc.max_depth_loc = Some(n.loc(p));
         }
         if let Some(n) = self.one(root, "BackfaceCulling") {
             self.desc.cull_backfaces = Some(n.boolean(p)?);
