@@ -44,6 +44,8 @@ pub struct SceneDesc {
     pub objects: Vec<ObjectDesc>,
     /// A lat-long environment image seen by rays that miss (`SphericalDirectionalLight`).
     pub environment: Option<PathBuf>,
+    /// Where the file names `environment`, for the message when it cannot be read.
+    pub environment_loc: Option<Location>,
     /// Things in the file that Arbor read but does not render (textures, motion blur...), one line each.
     pub warnings: Vec<String>,
 }
@@ -68,6 +70,7 @@ impl SceneDesc {
             materials: Vec::new(),
             objects: Vec::new(),
             environment: None,
+            environment_loc: None,
             warnings: Vec::new(),
         }
     }

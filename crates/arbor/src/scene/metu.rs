@@ -288,7 +288,9 @@ impl Reader<'_> {
                     radiance: self.req(n, "Radiance")?.vec3(p)?,
                 },
                 "SphericalDirectionalLight" => {
-                    let name = self.req(n, "EnvMapName")?.trimmed();
+                    let name_node = self.req(n, "EnvMapName")?;
+                    let name = name_node.trimmed();
+                    self.desc.environment_loc = Some(name_node.loc(p));
                     if self.desc.environment.is_some() {
                         let msg = "duplicate environment light; the last one wins".to_string();
                         self.notes.plain(n.loc(p), msg);
