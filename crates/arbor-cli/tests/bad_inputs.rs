@@ -119,6 +119,7 @@ fn catalogue() -> Vec<Row> {
     render("huge_image.xml", 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     render("huge_samples.xml", 3, "error: huge_samples.xml:3:9: Camera 1: NumSamples 1000000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     render("huge_work.xml", 3, "error: huge_work.xml:3:9: Camera 1: 268435456 pixels x 1024 samples = 274877906944 samples, more than the limit of 17179869184; --no-limits lifts the limits\n"),
+    render("huge_work_cameras.xml", 3, "error: huge_work_cameras.xml: the scene's 2 cameras ask for 21474836480 samples in all, more than the limit of 17179869184; --no-limits lifts the limits\n"),
     render("deep_recursion.xml", 3, "error: deep_recursion.xml:2:5: MaxRecursionDepth 100 exceeds the limit of 64; --no-limits lifts the limits\n"),
     // Not a scene file.
     render("not_utf8.xml", 3, "error: not_utf8.xml: byte 309: not UTF-8 text\n"),

@@ -24,7 +24,8 @@ pub struct SceneLimits {
     pub max_samples: u32,
     /// Largest `MaxRecursionDepth`.
     pub max_depth: u32,
-    /// Largest number of camera samples of one image (pixels x samples per pixel).
+    /// Largest number of camera samples (pixels x samples per pixel) of one image, and of all the
+    /// scene's images together.
     pub max_work: u64,
 }
 
@@ -48,7 +49,7 @@ impl SceneLimits {
 }
 
 /// Checks every camera of `desc` (with `spp`, the command line's samples per pixel, replacing the
-/// scene's) and its recursion depth against `limits`.
+/// scene's), all of them together, and the scene's recursion depth against `limits`.
 pub fn check_limits(desc: &SceneDesc, spp: Option<u32>, limits: &SceneLimits) -> Result<()> {
     if let Some(spp) = spp.filter(|&s| s > limits.max_samples) {
         let max = limits.max_samples;
@@ -59,6 +60,7 @@ pub fn check_limits(desc: &SceneDesc, spp: Option<u32>, limits: &SceneLimits) ->
         let msg = format!("MaxRecursionDepth {} exceeds the limit of {}; {LIFT}", desc.max_depth, limits.max_depth);
         return Err(Error::input(loc, msg));
     }
+    let mut total = 0u64;
     for c in &desc.cameras {
         let fail = |msg: String| Err(Error::input(c.loc.clone(), format!("Camera {}: {msg}; {LIFT}", c.id)));
         let (w, h) = (c.width, c.height);
@@ -80,6 +82,13 @@ pub fn check_limits(desc: &SceneDesc, spp: Option<u32>, limits: &SceneLimits) ->
             let max = limits.max_work;
             return fail(format!("{pixels} pixels x {samples} samples = {work} samples, more than the limit of {max}"));
         }
+        total = total.saturating_add(work);
+    }
+    if total > limits.max_work {
+        let (n, max) = (desc.cameras.len(), limits.max_work);
+        let msg =
+            format!("the scene's {n} cameras ask for {total} samples in all, more than the limit of {max}; {LIFT}");
+        return Err(Error::input(Location::file(&desc.source), msg));
     }
     Ok(())
 }
@@ -131,6 +140,27 @@ mod tests {
         // The command line's samples replace the scene's, for the total too.
         check_limits(&scene("8 8", 1_000_000, 0), Some(4), &SceneLimits::default()).unwrap();
         assert!(err(&scene("16384 16384", 1, 0), Some(1000)).contains("more than the limit"));
+    }
+
+    #[test]
+    fn limits_default_bounds_the_work_of_all_cameras_together() {
+        let cam = |id: u32| {
+            format!(
+                "<Camera id=\"{id}\"><Position>0 0 5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>\
+                 <NearPlane>-1 1 -1 1</NearPlane><NearDistance>1</NearDistance>\
+                 <ImageResolution>16384 16384</ImageResolution><NumSamples>40</NumSamples>\
+                 <ImageName>{id}.png</ImageName></Camera>"
+            )
+        };
+        let text = format!("<Scene><Cameras>{}{}</Cameras></Scene>", cam(1), cam(2));
+        let d = parse_desc(&text, Path::new("two.xml")).unwrap();
+        let e = err(&d, None);
+        assert_eq!(
+            e,
+            "two.xml: the scene's 2 cameras ask for 21474836480 samples in all, more than the limit of 17179869184; \
+             --no-limits lifts the limits"
+        );
+        check_limits(&d, Some(1), &SceneLimits::default()).unwrap();
     }
 
     #[test]
