@@ -6,9 +6,10 @@
 //! OFF formats.
 //!
 //! Every run must end within 10 s (else it is killed and the row fails), under a 1 GiB address-space
-//! limit, without a panic, and must write no image unless it succeeds. Errors exit 3 (4 for files that
-//! cannot be read); unknown elements and unused properties are warnings (`warning: file:line:col: ...`)
-//! and the render succeeds. An empty scene: no camera is an error, no objects renders the background.
+//! limit, without a panic, and must write no image unless it succeeds. Errors exit 3, or 4 when the file
+//! named on the command line cannot be read (a mesh or map the scene names is the scene's fault: 3).
+//! Unknown elements and unused properties are warnings (`warning: file:line:col: ...`) and the render
+//! succeeds. An empty scene: no camera is an error, no objects renders the background.
 //!
 //! The runs happen in the catalogue folder, so messages show paths relative to it, as a user sees them.
 //! To add a row, add the file and its expected message.
