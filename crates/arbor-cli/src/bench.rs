@@ -56,6 +56,9 @@ pub struct BenchArgs {
     /// One JSON document on standard output instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Lift the limits on image size and recursion depth (as `arbor render --no-limits`).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// The structures named by `--accel`.
@@ -106,6 +109,7 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     crate::set_threads(args.threads)?;
     let specs = specs(&args.accel.0, &args.accel_params)?;
     let desc = load_input(&args.input, args.size)?;
+    arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
     if desc.cameras.is_empty() {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", args.input)).into());
     }

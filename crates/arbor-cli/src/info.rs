@@ -22,6 +22,9 @@ pub struct InfoArgs {
     /// List the acceleration structures and their parameters, and exit.
     #[arg(long)]
     pub accels: bool,
+    /// Lift the limits on image size, samples and recursion depth (as `arbor render --no-limits`).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Runs `arbor info`.
@@ -36,6 +39,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         return Ok(());
     }
     let desc = crate::render::read_scene(&args.scene)?;
+    arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
     say!("scene      {}", crate::shown(&args.scene));
     say!(
         "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",

@@ -8,7 +8,7 @@ use arbor::accel::{AccelKind, AccelSpec};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, RenderOptions};
-use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
+use arbor::scene::{check_limits, load_desc, parse_desc, Scene, SceneDesc, SceneLimits};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -59,6 +59,10 @@ pub struct RenderArgs {
     /// No progress bar and no summary lines.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
+    /// depth (64) and pixels x samples (2^34) that guard against crafted scene files.
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Parses `--accel`.
@@ -80,6 +84,15 @@ pub fn read_scene(scene: &Option<PathBuf>) -> Result<SceneDesc, Failure> {
         Some(path) => load_desc(path)?,
         None => parse_desc(EXAMPLE, Path::new(EXAMPLE_NAME))?,
     })
+}
+
+/// The limits a scene is checked against: the defaults, or none with `--no-limits`.
+pub fn limits(no_limits: bool) -> SceneLimits {
+    if no_limits {
+        SceneLimits::none()
+    } else {
+        SceneLimits::default()
+    }
 }
 
 /// Runs `arbor render`.
@@ -112,6 +125,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     if cameras.is_empty() {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
     }
+    check_limits(&desc, args.spp, &limits(args.no_limits))?;
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
     let spec = accel_spec(args.accel, &args.accel_params)?;
     let scene = Scene::build(desc, &spec, env)?;

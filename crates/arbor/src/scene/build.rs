@@ -407,6 +407,11 @@ fn load_mesh_files(desc: &SceneDesc) -> Result<HashMap<PathBuf, Arc<TriangleMesh
                     object.loc.clone(),
                     format!("{}: cannot read mesh file '{}': {source}", object.name, path.display()),
                 ),
+                // A fault of the whole file (its extension, its emptiness) is the scene's reference to
+                // it: located at the element that names the file.
+                Error::Input { loc, msg } if loc.line.is_none() && loc.byte.is_none() => {
+                    Error::input(object.loc.clone(), format!("{}: mesh file '{}': {msg}", object.name, path.display()))
+                }
                 other => other,
             })?;
             Ok(((*path).clone(), Arc::new(mesh)))

@@ -26,6 +26,8 @@ pub struct SceneDesc {
     pub intersection_epsilon: f32,
     /// Bounces of mirror, conductor and dielectric rays; 0 means none.
     pub max_depth: u32,
+    /// Where the file sets `max_depth` (`MaxRecursionDepth`), for the limit check's message.
+    pub max_depth_loc: Option<Location>,
     /// Whether lights are tested for occlusion. The NYU assignment-4 renderer shades without shadow rays.
     pub shadows: bool,
     /// The scene's own back-face culling choice for primary rays (`BackfaceCulling`), if it makes one.
@@ -42,6 +44,8 @@ pub struct SceneDesc {
     pub objects: Vec<ObjectDesc>,
     /// A lat-long environment image seen by rays that miss (`SphericalDirectionalLight`).
     pub environment: Option<PathBuf>,
+    /// Where the file names `environment`, for the message when it cannot be read.
+    pub environment_loc: Option<Location>,
     /// Things in the file that Arbor read but does not render (textures, motion blur...), one line each.
     pub warnings: Vec<String>,
 }
@@ -57,6 +61,7 @@ impl SceneDesc {
             shadow_epsilon: 1e-3,
             intersection_epsilon: 1e-6,
             max_depth: 0,
+            max_depth_loc: None,
             shadows: true,
             cull_backfaces: None,
             cameras: Vec::new(),
@@ -65,6 +70,7 @@ impl SceneDesc {
             materials: Vec::new(),
             objects: Vec::new(),
             environment: None,
+            environment_loc: None,
             warnings: Vec::new(),
         }
     }

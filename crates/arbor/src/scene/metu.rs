@@ -197,6 +197,7 @@ impl Reader<'_> {
         }
         if let Some(n) = self.one(root, "MaxRecursionDepth") {
             self.desc.max_depth = n.uint(p)?;
+            self.desc.max_depth_loc = Some(n.loc(p));
         }
         if let Some(n) = self.one(root, "BackfaceCulling") {
             self.desc.cull_backfaces = Some(n.boolean(p)?);
@@ -287,7 +288,9 @@ impl Reader<'_> {
                     radiance: self.req(n, "Radiance")?.vec3(p)?,
                 },
                 "SphericalDirectionalLight" => {
-                    let name = self.req(n, "EnvMapName")?.trimmed();
+                    let name_node = self.req(n, "EnvMapName")?;
+                    let name = name_node.trimmed();
+                    self.desc.environment_loc = Some(name_node.loc(p));
                     if self.desc.environment.is_some() {
                         let msg = "duplicate environment light; the last one wins".to_string();
                         self.notes.plain(n.loc(p), msg);

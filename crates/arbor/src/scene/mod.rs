@@ -7,6 +7,7 @@
 mod build;
 pub mod desc;
 mod json;
+mod limits;
 mod metu;
 mod nyu_json;
 mod runtime;
@@ -17,6 +18,7 @@ use std::path::Path;
 
 pub use build::{build_geometry, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
 pub use desc::*;
+pub use limits::{check_limits, SceneLimits};
 pub use runtime::{Scene, Surface};
 
 use crate::{Error, Location, Result};

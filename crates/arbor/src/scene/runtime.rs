@@ -49,7 +49,7 @@ impl Scene {
                 // A map the scene names but that cannot be read is the scene's fault, like a missing mesh.
                 Some(path) => Some(EnvMap::load(path).map_err(|e| match e {
                     Error::Io { source, .. } => Error::input(
-                        Location::file(&desc.source),
+                        desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
                         format!("cannot read environment map '{}': {source}", path.display()),
                     ),
                     other => other,

@@ -160,7 +160,7 @@ impl Node {
     pub fn floats(&self, path: &Path) -> Result<Vec<f32>> {
         self.trimmed()
             .split_whitespace()
-            .map(|tok| parse_f32(tok).ok_or_else(|| self.malformed("number", tok, path)))
+            .map(|tok| parse_f32(tok).map_err(|what| self.malformed(what, tok, path)))
             .collect()
     }
     /// Exactly `n` numbers; with `extra_ok`, more are tolerated and the first `n` kept.
@@ -188,13 +188,13 @@ impl Node {
     pub fn ints(&self, path: &Path) -> Result<Vec<i64>> {
         self.trimmed()
             .split_whitespace()
-            .map(|tok| tok.parse().map_err(|_| self.malformed("integer", tok, path)))
+            .map(|tok| tok.parse().map_err(|_| self.malformed("malformed integer", tok, path)))
             .collect()
     }
     /// One non-negative integer.
     pub fn uint(&self, path: &Path) -> Result<u32> {
         let tok = self.trimmed();
-        tok.parse().map_err(|_| self.malformed("integer", tok, path))
+        tok.parse().map_err(|_| self.malformed("malformed integer", tok, path))
     }
     /// `true` or `false`.
     pub fn boolean(&self, path: &Path) -> Result<bool> {
@@ -203,7 +203,7 @@ impl Node {
         })
     }
     fn malformed(&self, what: &str, tok: &str, path: &Path) -> Error {
-        Error::input(self.loc(path), format!("<{}>: malformed {what} '{tok}'", self.name))
+        Error::input(self.loc(path), format!("<{}>: {what} '{tok}'", self.name))
     }
     /// Everything below this element that was never read, outermost first: an ignored element is
     /// reported once, not with each of its descendants.
@@ -228,9 +228,15 @@ impl Node {
     }
 }
 
-/// A finite `f32`; Rust's parser also accepts `inf` and `nan`, which no scene means.
-fn parse_f32(tok: &str) -> Option<f32> {
-    tok.parse::<f32>().ok().filter(|v| v.is_finite())
+/// A finite `f32`, or what is wrong with `tok`: Rust's parser also accepts `inf` and `nan`, which no
+/// scene means, and turns numbers beyond `f32` (`1e39`) into infinities.
+fn parse_f32(tok: &str) -> std::result::Result<f32, &'static str> {
+    match tok.parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_nan() || tok.to_ascii_lowercase().contains("inf") => Err("non-finite number"),
+        Ok(_) => Err("out-of-range number"),
+        Err(_) => Err("malformed number"),
+    }
 }
 
 #[cfg(test)]
@@ -254,7 +260,11 @@ mod tests {
         let e = node("Radius", " abc ").float(Path::new("scene.xml")).unwrap_err();
         assert_eq!(e.to_string(), "scene.xml:12:13: <Radius>: malformed number 'abc'");
         let e = node("Radius", "nan").float(Path::new("s.xml")).unwrap_err();
-        assert_eq!(e.to_string(), "s.xml:12:13: <Radius>: malformed number 'nan'");
+        assert_eq!(e.to_string(), "s.xml:12:13: <Radius>: non-finite number 'nan'");
+        let e = node("Radius", "-inf").float(Path::new("s.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "s.xml:12:13: <Radius>: non-finite number '-inf'");
+        let e = node("Radius", "1e39").float(Path::new("s.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "s.xml:12:13: <Radius>: out-of-range number '1e39'");
     }
 
     #[test]

@@ -12,14 +12,19 @@ use crate::{Error, Location, Result};
 /// Parses `text` (the content of `path`) into the tree of its root element.
 pub fn parse(text: &str, path: &Path) -> Result<Node> {
     let opts = roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() };
+    let lines = LineIndex::new(text);
     let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
         let pos = e.pos();
         let msg = e.to_string();
         // roxmltree appends the position to its message; the location already says it.
         let msg = msg.strip_suffix(&format!(" at {}:{}", pos.row, pos.col)).unwrap_or(&msg);
-        Error::input(Location::at(path, pos.row, pos.col), format!("XML syntax error: {msg}"))
+        // A truncated file ends where the text ends, not at the 1:1 roxmltree reports.
+        let (row, col) = match e {
+            roxmltree::Error::UnexpectedEndOfStream | roxmltree::Error::UnclosedRootNode => lines.pos(text.len()),
+            _ => (pos.row, pos.col),
+        };
+        Error::input(Location::at(path, row, col), format!("XML syntax error: {msg}"))
     })?;
-    let lines = LineIndex::new(text);
     convert(doc.root_element(), &lines, 0, path)
 }
 
@@ -91,6 +96,16 @@ mod tests {
         let s = e.to_string();
         assert!(s.starts_with("bad.xml:2:"), "{s}");
         assert!(s.contains("XML syntax error"), "{s}");
+    }
+
+    #[test]
+    fn xml_truncated_file_is_located_at_its_end() {
+        let e = parse("<Scene>\n  <A>1</A>\n  <B", Path::new("cut.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "cut.xml:3:5: XML syntax error: the root node was opened but never closed");
+        let e = parse("<Scene>\n  <A x=\"1", Path::new("cut.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "cut.xml:2:10: XML syntax error: unexpected end of stream");
+        let e = parse("<Scene>\n  <A>1</A>\n", Path::new("cut.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "cut.xml:3:1: XML syntax error: the root node was opened but never closed");
     }
 
     #[test]

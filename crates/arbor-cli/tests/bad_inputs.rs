@@ -1,0 +1,242 @@
+//! The bad-input catalogue: every file of `tests/bad_inputs/` given to the real `arbor` binary, with the
+//! exit code and the exact standard error expected. Each scene file is one kind of bad input (truncated
+//! files, wrong counts, non-numbers, NaN and infinite coordinates, indices out of range, missing ids and
+//! files, self references, unknown elements, empty scenes, zero-size images, resource limits); scenes
+//! named `mesh_*` refer to a bad mesh file next to them, in each of the PLY (ASCII and binary), OBJ and
+//! OFF formats.
+//!
+//! Every run must end within 10 s (else it is killed and the row fails), under a 1 GiB address-space
+//! limit, without a panic, and must write no image unless it succeeds. Errors exit 3, or 4 when the file
+//! named on the command line cannot be read (a mesh or map the scene names is the scene's fault: 3).
+//! Unknown elements and unused properties are warnings (`warning: file:line:col: ...`) and the render
+//! succeeds. An empty scene: no camera is an error, no objects renders the background.
+//!
+//! The runs happen in the catalogue folder, so messages show paths relative to it, as a user sees them.
+//! To add a row, add the file and its expected message.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// One run: the arguments after `arbor` (`OUT` stands for the output folder), the exit code, stderr.
+struct Row {
+    args: Vec<&'static str>,
+    code: i32,
+    stderr: &'static str,
+}
+
+/// `arbor render SCENE -o OUT`.
+fn render(scene: &'static str, code: i32, stderr: &'static str) -> Row {
+    Row { args: vec!["render", scene, "-o", "OUT"], code, stderr }
+}
+
+/// Any other command line.
+fn cmd(args: &[&'static str], code: i32, stderr: &'static str) -> Row {
+    Row { args: args.to_vec(), code, stderr }
+}
+
+#[rustfmt::skip]
+fn catalogue() -> Vec<Row> {
+    vec![
+    // Truncated files.
+    render("truncated.xml", 3, "error: truncated.xml:18:19: XML syntax error: unexpected end of stream\n"),
+    render("truncated.json", 3, "error: truncated.json:7: JSON syntax error: EOF while parsing a value\n"),
+    render("empty_file.xml", 3, "error: empty_file.xml:1:1: XML syntax error: the document does not have a root node\n"),
+    render("mesh_truncated_ascii.xml", 3, "error: truncated_ascii.ply:3: element `vertex` claims 3 entries but only 2 lines are left for it\n"),
+    render("mesh_truncated_binary.xml", 3, "error: truncated_binary.ply: byte 206: unexpected end of file in face 0 of 1 (needs 12 more bytes, 4 left)\n"),
+    render("mesh_truncated_off.xml", 3, "error: truncated.off:2: header claims 3 vertices and 1 faces but only 2 lines follow\n"),
+    render("mesh_truncated_obj.xml", 3, "error: truncated.obj:4: face has 2 vertices (a face needs at least 3)\n"),
+    render("mesh_empty_ply.xml", 3, "error: empty.ply:1: not a PLY file (the first line must be `ply`)\n"),
+    render("mesh_empty_off.xml", 3, "error: mesh_empty_off.xml:29:9: Mesh 1: mesh file 'empty.off': empty file (expected `OFF`)\n"),
+    // Headers that claim more elements than the file holds: refused before allocating.
+    render("mesh_huge_count_ply.xml", 3, "error: huge_count.ply:3: element `vertex` claims 4000000000 entries but only 1 lines are left for it\n"),
+    render("mesh_huge_count_binary.xml", 3, "error: huge_count_binary.ply:3: element `vertex` claims 1000000000 entries (at least 12000000000 bytes) but only 12 bytes are left for it\n"),
+    render("mesh_huge_count_off.xml", 3, "error: huge_count.off:2: header claims 3000000000 vertices and 2000000000 faces but only 1 lines follow\n"),
+    // Wrong counts.
+    render("faces_not_triples.xml", 3, "error: faces_not_triples.xml:29:44: <Faces>: expected vertex id triples, found 4 ids\n"),
+    render("vertexdata_not_triples.xml", 3, "error: vertexdata_not_triples.xml:23:5: <VertexData>: expected x y z triples, found 4 numbers\n"),
+    render("resolution_one_number.xml", 3, "error: resolution_one_number.xml:9:13: <ImageResolution>: expected two positive integers\n"),
+    render("position_two_numbers.json", 3, "error: position_two_numbers.json:6:9: <Position>: expected 3 numbers, found 2\n"),
+    render("nyu_color_two_numbers.json", 3, "error: nyu_color_two_numbers.json:5:29: \"Color\": expected an array of 3 numbers\n"),
+    // Non-numbers.
+    render("position_not_a_number.xml", 3, "error: position_not_a_number.xml:4:13: <Position>: malformed number 'zero'\n"),
+    render("resolution_not_integer.xml", 3, "error: resolution_not_integer.xml:9:13: <ImageResolution>: malformed integer '8.5'\n"),
+    render("huge_depth_number.xml", 3, "error: huge_depth_number.xml:2:5: <MaxRecursionDepth>: malformed integer '99999999999'\n"),
+    render("nyu_not_a_number.json", 3, "error: nyu_not_a_number.json:2:60: \"FieldOfView\": expected a number\n"),
+    render("mesh_not_a_number_ply.xml", 3, "error: not_a_number.ply:12:5: malformed number `zz`\n"),
+    render("mesh_not_a_number_obj.xml", 3, "error: not_a_number.obj:2:5: malformed number `x`\n"),
+    render("mesh_not_a_number_off.xml", 3, "error: not_a_number.off:5:3: malformed number `one`\n"),
+    // NaN and infinite coordinates.
+    render("nan_vertex.xml", 3, "error: nan_vertex.xml:23:5: <VertexData>: non-finite number 'nan'\n"),
+    render("inf_radius.xml", 3, "error: inf_radius.xml:29:64: <Radius>: non-finite number 'inf'\n"),
+    render("overflow_coordinate.xml", 3, "error: overflow_coordinate.xml:23:5: <VertexData>: out-of-range number '1e39'\n"),
+    render("inf_position.json", 3, "error: inf_position.json:6:9: <Position>: non-finite number 'Infinity'\n"),
+    render("nyu_overflow.json", 3, "error: nyu_overflow.json:2:60: JSON syntax error: number out of range\n"),
+    render("mesh_nan_ply.xml", 3, "error: nan.ply:12: vertex 2: non-finite y (NaN)\n"),
+    render("mesh_nan_binary_ply.xml", 3, "error: nan_binary.ply: byte 193: vertex 2: non-finite y (NaN)\n"),
+    render("mesh_inf_obj.xml", 3, "error: inf.obj:3:5: non-finite coordinate `inf`\n"),
+    render("mesh_inf_off.xml", 3, "error: inf.off:5:5: non-finite coordinate `-inf`\n"),
+    // Indices out of range.
+    render("face_index_out_of_range.xml", 3, "error: face_index_out_of_range.xml:29:44: Mesh 1: vertex index 9 out of range (VertexData has 3 vertices, numbered from 1)\n"),
+    render("face_index_zero.xml", 3, "error: face_index_zero.xml:29:44: Mesh 1: vertex index 0 out of range (VertexData has 3 vertices, numbered from 1)\n"),
+    render("vertex_offset_out_of_range.xml", 3, "error: vertex_offset_out_of_range.xml:29:44: Mesh 1: vertex index 1 + vertexOffset -5 = -4 out of range (VertexData has 3 vertices, numbered from 1)\n"),
+    render("sphere_center_out_of_range.xml", 3, "error: sphere_center_out_of_range.xml:29:46: Sphere 1: centre vertex 4 out of range (VertexData has 3 vertices, numbered from 1)\n"),
+    render("nyu_material_out_of_range.json", 3, "error: nyu_material_out_of_range.json:6:24: \"Material\": Sphere 0: no material 2 (the scene has 0, numbered from 0)\n"),
+    render("mesh_index_ply.xml", 3, "error: index_out_of_range.ply:13:7: face 0: vertex index 3 out of range (the file has 3 vertices)\n"),
+    render("mesh_index_binary_ply.xml", 3, "error: index_out_of_range_binary.ply: byte 214: face 0: vertex index -1 out of range (the file has 3 vertices)\n"),
+    render("mesh_index_obj.xml", 3, "error: index_out_of_range.obj:4:7: vertex index 4 out of range (3 defined so far)\n"),
+    render("mesh_index_off.xml", 3, "error: index_out_of_range.off:6:7: face 0: vertex index 3 out of range (the file has 3 vertices)\n"),
+    // References to missing ids or files (a file the scene names is the scene's fault: exit 3).
+    render("missing_material.xml", 3, "error: missing_material.xml:29:24: Sphere 1: unknown material id '7'\n"),
+    render("missing_transformation.xml", 3, "error: missing_transformation.xml:29:82: <Transformations>: unknown transformation 't5'\n"),
+    render("missing_base_mesh.xml", 3, "error: missing_base_mesh.xml:30:30: MeshInstance 2: unknown base mesh id '9'\n"),
+    render("missing_mesh_file.xml", 3, "error: missing_mesh_file.xml:29:9: Mesh 1: cannot read mesh file 'nowhere.ply': No such file or directory (os error 2)\n"),
+    render("nyu_missing_mesh_file.json", 3, "error: nyu_missing_mesh_file.json:6:6: Mesh 0: cannot read mesh file 'nowhere.off': No such file or directory (os error 2)\n"),
+    render("env_missing.xml", 3, "error: env_missing.xml:14:43: cannot read environment map 'sky.exr': No such file or directory (os error 2)\n"),
+    render("unknown_mesh_extension.xml", 3, "error: unknown_mesh_extension.xml:29:9: Mesh 1: mesh file 'mesh.stl': unknown mesh file extension `.stl` (supported: .ply, .obj, .off)\n"),
+    // Self references. METU has no include; a plyFile may name the scene itself, and a MeshInstance may
+    // name itself or another instance (bases must be <Mesh> ids, so no cycle can be written).
+    render("ply_is_the_scene.xml", 3, "error: ply_is_the_scene.xml:29:9: Mesh 1: mesh file 'ply_is_the_scene.xml': unknown mesh file extension `.xml` (supported: .ply, .obj, .off)\n"),
+    render("ply_is_xml.xml", 3, "error: scene_as.ply:1: not a PLY file (the first line must be `ply`)\n"),
+    render("instance_of_itself.xml", 3, "error: instance_of_itself.xml:29:30: MeshInstance 1: unknown base mesh id '1'\n"),
+    render("instance_loop.xml", 3, "error: instance_loop.xml:29:30: MeshInstance 1: unknown base mesh id '2'\n"),
+    render("instance_of_sphere.xml", 3, "error: instance_of_sphere.xml:30:30: MeshInstance 2: unknown base mesh id '1'\n"),
+    // Unknown elements and unused properties: warnings, and the render succeeds.
+    render("unknown_element.xml", 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    render("unknown_element.json", 0, "warning: unknown_element.json:3:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    render("unused_property.xml", 0, "warning: unused_property.xml:3:24: attribute lens of <Camera> ignored (unknown or unused here)\nwarning: unused_property.xml:29:82: <Faces> in <Sphere> ignored (unknown or unused here)\n"),
+    render("nyu_unknown_key.json", 0, "warning: nyu_unknown_key.json:6:75: \"Colour\" in an object ignored (unknown)\n"),
+    // Empty scenes: no camera is an error; no objects renders the background.
+    render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
+    render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
+    render("no_objects.xml", 0, ""),
+    render("empty_object.json", 3, "error: empty_object.json:1:1: no top-level \"Scene\" object\n"),
+    render("not_a_scene.xml", 3, "error: not_a_scene.xml:1:1: root element is <Mesh>, expected <Scene>\n"),
+    // Zero-size images.
+    render("zero_size.xml", 3, "error: zero_size.xml:9:13: <ImageResolution>: expected two positive integers\n"),
+    render("zero_width.json", 3, "error: zero_width.json:11:9: <ImageResolution>: expected two positive integers\n"),
+    render("negative_size.xml", 3, "error: negative_size.xml:9:13: <ImageResolution>: expected two positive integers\n"),
+    // Resource limits.
+    render("huge_image.xml", 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
+    render("huge_samples.xml", 3, "error: huge_samples.xml:3:9: Camera 1: NumSamples 1000000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
+    render("huge_work.xml", 3, "error: huge_work.xml:3:9: Camera 1: 268435456 pixels x 1024 samples = 274877906944 samples, more than the limit of 17179869184; --no-limits lifts the limits\n"),
+    render("huge_work_cameras.xml", 3, "error: huge_work_cameras.xml: the scene's 2 cameras ask for 21474836480 samples in all, more than the limit of 17179869184; --no-limits lifts the limits\n"),
+    render("deep_recursion.xml", 3, "error: deep_recursion.xml:2:5: MaxRecursionDepth 100 exceeds the limit of 64; --no-limits lifts the limits\n"),
+    // Not a scene file.
+    render("not_utf8.xml", 3, "error: not_utf8.xml: byte 309: not UTF-8 text\n"),
+    render("scene.txt", 3, "error: scene.txt: unknown scene format '.txt' (expected .xml or .json)\n"),
+    // Files that cannot be read: I/O errors, exit 4.
+    cmd(&["render", "no_such_scene.xml", "-o", "OUT"], 4, "error: no_such_scene.xml: No such file or directory (os error 2)\n"),
+    // Limits: --spp on the command line, the flag that lifts them, and the other commands.
+    cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "error: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
+    cmd(&["render", "deep_recursion.xml", "--no-limits", "-o", "OUT"], 0, ""),
+    cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
+    cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
+    cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
+    // Mesh files given directly.
+    cmd(&["bench", "huge_count.off"], 3, "error: huge_count.off:2: header claims 3000000000 vertices and 2000000000 faces but only 1 lines follow\n"),
+    cmd(&["bench", "scene_as.ply"], 3, "error: scene_as.ply:1: not a PLY file (the first line must be `ply`)\n"),
+    ]
+}
+
+/// What went wrong with one row, if anything.
+fn run(row: &Row, dir: &Path, out: &Path) -> Result<(), String> {
+    let args: Vec<&str> = row.args.iter().map(|a| if *a == "OUT" { out.to_str().unwrap() } else { a }).collect();
+    let err_path = out.with_extension("stderr");
+    let err_file = std::fs::File::create(&err_path).unwrap();
+    let mut command = limited(&args);
+    let mut child = command
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(err_file)
+        .spawn()
+        .expect("arbor runs");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(10) {
+            child.kill().ok();
+            child.wait().ok();
+            return Err("still running after 10 s: killed".into());
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    let stderr = std::fs::read_to_string(&err_path).unwrap();
+    if stderr.contains("panicked") || status.code() == Some(101) {
+        return Err(format!("panicked: {stderr}"));
+    }
+    let Some(code) = status.code() else {
+        return Err(format!("killed by a signal (out of memory?): {status}; stderr: {stderr}"));
+    };
+    if (code, stderr.as_str()) != (row.code, row.stderr) {
+        return Err(format!("exit {code}, stderr:\n{stderr}expected exit {}, stderr:\n{}", row.code, row.stderr));
+    }
+    let written = std::fs::read_dir(out).map_or(0, |d| d.count());
+    if row.args[0] == "render" && (code == 0) != (written > 0) {
+        return Err(format!("exit {code} but {written} files written"));
+    }
+    Ok(())
+}
+
+/// `arbor args`, limited to 1 GiB of address space where the shell can say so.
+fn limited(args: &[&str]) -> Command {
+    let exe = env!("CARGO_BIN_EXE_arbor");
+    if cfg!(unix) {
+        let mut c = Command::new("sh");
+        c.arg("-c").arg("ulimit -v 1048576 && exec \"$0\" \"$@\"").arg(exe).args(args);
+        c
+    } else {
+        let mut c = Command::new(exe);
+        c.args(args);
+        c
+    }
+}
+
+fn catalogue_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_inputs")
+}
+
+#[test]
+fn bad_inputs_give_located_errors_and_never_panic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (i, row) in catalogue().iter().enumerate() {
+        let out = tmp.path().join(format!("run{i}"));
+        if let Err(e) = run(row, &catalogue_dir(), &out) {
+            failures.push(format!("arbor {}: {e}", row.args.join(" ")));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} rows failed:\n\n{}",
+        failures.len(),
+        catalogue().len(),
+        failures.join("\n\n")
+    );
+}
+
+/// Every scene of the catalogue has its row, and every mesh file is named by some scene or row, so that
+/// no file lies there untested.
+#[test]
+fn bad_inputs_catalogue_is_complete() {
+    let rows = catalogue();
+    let named = |name: &str| rows.iter().any(|r| r.args.contains(&name));
+    let mut scenes = String::new();
+    let mut meshes = Vec::new();
+    for entry in std::fs::read_dir(catalogue_dir()).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        match Path::new(&name).extension().and_then(|e| e.to_str()) {
+            Some("ply" | "obj" | "off") => meshes.push(name),
+            _ => {
+                assert!(named(&name), "no row for {name}");
+                scenes.push_str(&String::from_utf8_lossy(&std::fs::read(catalogue_dir().join(&name)).unwrap()));
+            }
+        }
+    }
+    for m in meshes {
+        assert!(scenes.contains(&format!("\"{m}\"")) || named(&m), "no scene or row uses {m}");
+    }
+}
