@@ -79,12 +79,8 @@ fn interrupt_sigint_keeps_the_older_image() {
 }
 
 fn render_png(out: &Path, extra: &[&str]) -> (u32, u32, Vec<u8>) {
-    let status = Command::new(ARBOR)
-        .args(["render", "--quiet", "--spp", "2", "-o"])
-        .arg(out)
-        .args(extra)
-        .status()
-        .unwrap();
+    let status =
+        Command::new(ARBOR).args(["render", "--quiet", "--spp", "2", "-o"]).arg(out).args(extra).status().unwrap();
     assert!(status.success(), "arbor render {extra:?}: {status}");
     arbor::image_io::read_rgb8(&out.join("cornell_box.png")).unwrap()
 }

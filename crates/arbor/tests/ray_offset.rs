@@ -109,7 +109,12 @@ fn ray_offset_error_bound_no_acne_on_quads_and_planes_far_from_the_origin() {
     // A quad in object space around the origin, scaled by 1e-3 and moved far away.
     let t = Transform::scale(Vec3::splat(1e-3)).unwrap().then(&Transform::translate(c));
     let unit = mesh(
-        vec![Vec3::new(-1.0, -1.0, 0.1), Vec3::new(1.0, -1.0, -0.2), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.3)],
+        vec![
+            Vec3::new(-1.0, -1.0, 0.1),
+            Vec3::new(1.0, -1.0, -0.2),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.3),
+        ],
         vec![[0, 1, 2], [0, 2, 3]],
     );
     let s = scene(vec![object(unit, t)], OffsetRule::ErrorBound);
@@ -127,7 +132,12 @@ fn leaks(rule: OffsetRule) -> usize {
         vec![[0, 1, 2], [0, 2, 3]],
     );
     let lid = mesh(
-        vec![Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.01, 1.0), Vec3::new(1.0, 0.01, -1.0)],
+        vec![
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.01, 1.0),
+            Vec3::new(1.0, 0.01, -1.0),
+        ],
         vec![[0, 2, 1], [0, 3, 2]],
     );
     let s = scene(vec![object(floor, Transform::IDENTITY), object(lid, Transform::IDENTITY)], rule);

@@ -156,7 +156,8 @@ fn reproducible_example_for_thread_counts_and_crops() {
 
     // Tile order: every 16x16 tile rendered alone, last tile first, on one thread.
     let mut assembled = Film::new(w, h);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(16)).flat_map(|ty| (0..w.div_ceil(16)).map(move |tx| (tx, ty))).collect();
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(16)).flat_map(|ty| (0..w.div_ceil(16)).map(move |tx| (tx, ty))).collect();
     for &(tx, ty) in tiles.iter().rev() {
         let crop = (tx * 16, ty * 16, ((tx + 1) * 16).min(w), ((ty + 1) * 16).min(h));
         let part = render_on(1, &scene, 0, &RenderOptions { crop: Some(crop), ..Default::default() });
