@@ -96,7 +96,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::TooDifferent) => ExitCode::from(1),
         Err(Failure::Interrupted(code)) => {
-            eprintln!("interrupted: no image written for the render in progress");
+            eprintln!("interrupted: an image whose render was stopped is not written");
             ExitCode::from(code)
         }
         Err(Failure::Arbor(e)) => {

@@ -238,7 +238,8 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
             say!("heatmap maximum {max} (nodes visited + primitives tested) for {}", path.display());
         }
     }
-    Ok(())
+    // A signal during the last write let that (atomic) write finish; the run still reports it.
+    signals.check()
 }
 
 /// A bar on standard error, drawn only on a terminal (indicatif hides it otherwise).

@@ -35,8 +35,8 @@ pub struct RenderOptions {
     /// Render a debug view instead of (or over) the Whitted image.
     pub debug: Option<DebugView>,
     /// Render only the pixels `x0..x1` x `y0..y1` of the full frame (the film is the crop's size);
-    /// clamped to the frame. Box overlays are drawn in full-frame coordinates; the heatmap's scale and
-    /// legend are those of the cropped image.
+    /// clamped to the frame. Box overlays are drawn in full-frame coordinates; the heatmap is scaled by
+    /// the crop's own maximum, and its legend shows where the crop covers the frame's bottom rows.
     pub crop: Option<(u32, u32, u32, u32)>,
     /// Stop early when this becomes true (a signal handler sets it): no tile starts after that.
     pub cancel: Option<Arc<AtomicBool>>,
