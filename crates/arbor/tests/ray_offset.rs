@@ -165,3 +165,53 @@ fn ray_offset_error_bound_no_light_leaking_between_touching_quads() {
     // The fixed 1e-3 of the METU formats lifts the origin above the lid where the gap is below 1e-3.
     assert!(leaks(OffsetRule::ShadowEpsilon) > 100);
 }
+
+/// Through the Whitted integrator: a lone sphere far from the origin under a point light, rendered with
+/// shadow rays and without. A convex object never shadows itself where it faces the light, so any
+/// difference is acne.
+#[test]
+fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
+    use arbor::render::{render, RenderOptions};
+    use arbor::scene::{CameraDesc, LightDesc, Window};
+
+    let center = Vec3::new(1e4, -1e4, 3e4);
+    let mut images = Vec::new();
+    for shadows in [true, false] {
+        let mut d = SceneDesc::new("offset.json");
+        d.offset = OffsetRule::ErrorBound;
+        d.shadows = shadows;
+        d.radiance_scale = 1.0 / 255.0;
+        d.materials.push(MaterialDesc {
+            id: "m".into(),
+            ambient: Color::ZERO,
+            diffuse: Color::splat(1.0),
+            specular: Color::splat(0.5),
+            phong_exponent: 20.0,
+            kind: MaterialKind::BlinnPhong,
+        });
+        d.objects.push(object(ShapeDesc::Sphere { center, radius: 50.0 }, Transform::IDENTITY));
+        d.lights
+            .push(LightDesc::Point { position: center + Vec3::new(300.0, 400.0, 500.0), intensity: Color::splat(1e8) });
+        d.cameras.push(CameraDesc {
+            id: "1".into(),
+            position: center + Vec3::new(0.0, 0.0, 200.0),
+            gaze: -Vec3::Z,
+            up: Vec3::Y,
+            window: Window { left: -0.3, right: 0.3, bottom: -0.3, top: 0.3 },
+            near_distance: 1.0,
+            orthographic: false,
+            width: 48,
+            height: 48,
+            image_name: "x.png".into(),
+            num_samples: 1,
+            transform: Transform::IDENTITY,
+            lens: None,
+            loc: Location::file("test"),
+        });
+        let s = Scene::build(d, &AccelSpec::new(AccelKind::BvhSah), None).unwrap();
+        images.push(render(&s, 0, &RenderOptions::default(), &|_, _| {}).0);
+    }
+    let lit = images[1].pixels.iter().filter(|c| c.x > 0.05).count();
+    assert!(lit > 200, "only {lit} lit pixels: the test sees too little of the sphere");
+    assert_eq!(images[0].pixels, images[1].pixels, "shadow rays darkened the sphere's lit side");
+}
