@@ -1,7 +1,7 @@
 //! `arbor`: render scene files, describe them, benchmark their acceleration structures, compare images.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
-//! 4 I/O failure.
+//! 4 I/O failure, 130 and 143 when `render` was stopped by SIGINT or SIGTERM (no image written).
 
 /// Prints a line to standard output. A closed pipe (`arbor info | head -1`) ends the program quietly
 /// instead of panicking, as command-line tools do.
@@ -47,6 +47,8 @@ pub enum Failure {
     TooDifferent,
     /// An error from the library (exit 3 for bad input, 4 for I/O).
     Arbor(arbor::Error),
+    /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
+    Interrupted(u8),
 }
 
 impl From<arbor::Error> for Failure {
@@ -93,6 +95,10 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::TooDifferent) => ExitCode::from(1),
+        Err(Failure::Interrupted(code)) => {
+            eprintln!("interrupted: an image whose render was stopped is not written");
+            ExitCode::from(code)
+        }
         Err(Failure::Arbor(e)) => {
             eprintln!("error: {e}");
             ExitCode::from(if e.is_io() { 4 } else { 3 })

@@ -1,7 +1,14 @@
 //! `arbor render`: every camera of a scene to the image file it names, with a progress bar on a terminal
 //! and one summary line per image.
+//!
+//! SIGINT and SIGTERM stop the render between tiles: the image being rendered is not written (the
+//! previous file, if any, stays as it was; images are written whole, by rename), and the command exits
+//! 130 or 143. A second signal while the first is being honoured (e.g. during a long mesh load) exits at
+//! once with the same code.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use arbor::accel::{AccelKind, AccelSpec};
@@ -56,6 +63,10 @@ pub struct RenderArgs {
     /// Render only the camera with this id.
     #[arg(long)]
     pub camera: Option<String>,
+    /// Render only the window X0,Y0,X1,Y1 of each image (pixels X0..X1, Y0..Y1, top-left origin): the
+    /// output is the window's size, and its pixels equal the same pixels of the full render.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
+    pub crop: Option<(u32, u32, u32, u32)>,
     /// No progress bar and no summary lines.
     #[arg(short, long)]
     pub quiet: bool,
@@ -68,6 +79,50 @@ pub struct RenderArgs {
 /// Parses `--accel`.
 pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
     s.parse()
+}
+
+/// Parses `--crop X0,Y0,X1,Y1`.
+pub fn parse_crop(s: &str) -> Result<(u32, u32, u32, u32), String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<u32>().map_err(|_| format!("'{p}' is not a pixel coordinate")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok((x0, y0, x1, y1)),
+        [_, _, _, _] => Err("the window is empty: need X0 < X1 and Y0 < Y1".into()),
+        _ => Err(format!("expected X0,Y0,X1,Y1, got {} numbers", v.len())),
+    }
+}
+
+/// Flags set by SIGINT and SIGTERM: `cancel` stops the render, the other two say which signal came.
+struct Signals {
+    cancel: Arc<AtomicBool>,
+    int: Arc<AtomicBool>,
+    term: Arc<AtomicBool>,
+}
+
+impl Signals {
+    fn install() -> Result<Signals, Failure> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let s = Signals { cancel: Arc::default(), int: Arc::default(), term: Arc::default() };
+        for (sig, which, code) in [(SIGINT, &s.int, 130), (SIGTERM, &s.term, 143)] {
+            let ok = signal_hook::flag::register_conditional_shutdown(sig, code, Arc::clone(&s.cancel))
+                .and_then(|_| signal_hook::flag::register(sig, Arc::clone(which)))
+                .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&s.cancel)));
+            ok.map_err(|e| arbor::Error::Invalid(format!("cannot install a signal handler: {e}")))?;
+        }
+        Ok(s)
+    }
+
+    /// `Err(Interrupted)` once a signal came.
+    fn check(&self) -> Result<(), Failure> {
+        match (self.int.load(Ordering::SeqCst), self.term.load(Ordering::SeqCst)) {
+            (true, _) => Err(Failure::Interrupted(130)),
+            (_, true) => Err(Failure::Interrupted(143)),
+            _ if self.cancel.load(Ordering::SeqCst) => Err(Failure::Interrupted(130)),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// The structure and parameters named on the command line.
@@ -97,6 +152,7 @@ pub fn limits(no_limits: bool) -> SceneLimits {
 
 /// Runs `arbor render`.
 pub fn run(args: RenderArgs) -> Result<(), Failure> {
+    let signals = Signals::install()?;
     crate::set_threads(args.threads)?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
@@ -139,13 +195,27 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
             None
         },
         debug: args.debug,
+        crop: args.crop,
+        cancel: Some(Arc::clone(&signals.cancel)),
     };
+    if let Some((_, _, x1, y1)) = args.crop {
+        if let Some(cam) = cameras.iter().map(|&c| &scene.desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
+            return Err(arbor::Error::Invalid(format!(
+                "--crop reaches pixel ({x1}, {y1}) but camera '{}' is {}x{}",
+                cam.id, cam.width, cam.height
+            ))
+            .into());
+        }
+    }
     for &c in &cameras {
         let cam = &scene.desc.cameras[c];
         let path = args.out.join(&cam.image_name);
         let bar = progress_bar(args.quiet, cam.width as u64 * cam.height as u64, &cam.image_name);
+        signals.check()?;
         let (film, stats) = render(&scene, c, &opts, &|done, _| bar.set_position(done));
         bar.finish_and_clear();
+        // A signal during the render leaves an incomplete film: never written.
+        signals.check()?;
         arbor::image_io::write_image(&path, &film)?;
         if !args.quiet {
             let g = &scene.geometry.counts;
@@ -153,8 +223,8 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
                 "{}  {}x{}  {} spp  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
                  render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
                 path.display(),
-                cam.width,
-                cam.height,
+                film.width,
+                film.height,
                 stats.spp,
                 (parse_time + g.mesh_load).as_secs_f64() * 1e3,
                 scene.build_time.as_secs_f64() * 1e3,
@@ -182,7 +252,8 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
             say!("heatmap maximum {max} (nodes visited + primitives tested) for {}", path.display());
         }
     }
-    Ok(())
+    // A signal during the last write let that (atomic) write finish; the run still reports it.
+    signals.check()
 }
 
 /// A bar on standard error, drawn only on a terminal (indicatif hides it otherwise).

@@ -1,10 +1,16 @@
 //! Rendering one camera's image: 16x16 tiles traced in parallel over rayon. Each pixel sample draws from
 //! its own random stream ([`crate::sampler`]), so the image does not depend on thread count or tile order.
 //!
+//! A crop ([`RenderOptions::crop`]) traces only the tiles of the full frame that overlap a window, with
+//! the full frame's pixel coordinates and random streams, so its pixels are those of the full render.
+//! A cancellation flag ([`RenderOptions::cancel`]) is checked before every tile: once set, the remaining
+//! tiles are skipped and the result is marked [`RenderStats::cancelled`] (it must not be written).
+//!
 //! A debug view ([`RenderOptions::debug`]) either replaces the Whitted integrator by one ray through each
 //! pixel centre ([`DebugIntegrator`]), or draws over the finished Whitted image (boxes).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -28,6 +34,12 @@ pub struct RenderOptions {
     pub cull_backfaces: Option<bool>,
     /// Render a debug view instead of (or over) the Whitted image.
     pub debug: Option<DebugView>,
+    /// Render only the pixels `x0..x1` x `y0..y1` of the full frame (the film is the crop's size);
+    /// clamped to the frame. Box overlays are drawn in full-frame coordinates; the heatmap is scaled by
+    /// the crop's own maximum, and its legend shows where the crop covers the frame's bottom rows.
+    pub crop: Option<(u32, u32, u32, u32)>,
+    /// Stop early when this becomes true (a signal handler sets it): no tile starts after that.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 /// What a render measured.
@@ -41,6 +53,8 @@ pub struct RenderStats {
     pub spp: u32,
     /// The heatmap view's largest per-pixel cost (nodes visited plus primitives tested).
     pub heatmap_max: Option<u32>,
+    /// The render was cancelled before it finished: the film is incomplete.
+    pub cancelled: bool,
 }
 
 impl RenderStats {
@@ -67,17 +81,22 @@ pub fn render(
     let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
     let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(desc.num_samples).max(1) };
     let (w, h) = (cam.width, cam.height);
-    let tiles: Vec<(u32, u32)> =
-        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
-    let total = w as u64 * h as u64;
+    let (cx0, cy0, cx1, cy1) = crop_window(opts.crop, w, h);
+    // The full frame's tile grid, cut to the window: pixel values do not depend on it, only on (x, y, k).
+    let tiles: Vec<(u32, u32, u32, u32)> = (cy0 / TILE..cy1.div_ceil(TILE))
+        .flat_map(|ty| (cx0 / TILE..cx1.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .map(|(x, y)| (x.max(cx0), y.max(cy0), (x + TILE).min(cx1), (y + TILE).min(cy1)))
+        .collect();
+    let total = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
+    let is_cancelled = || opts.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed));
     let done = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.desc.radiance_scale };
 
-    let rendered: Vec<((u32, u32), Vec<Color>)> = tiles
+    let rendered: Vec<((u32, u32, u32), Vec<Color>)> = tiles
         .par_iter()
-        .map(|&(x0, y0)| {
-            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+        .filter(|_| !is_cancelled())
+        .map(|&(x0, y0, x1, y1)| {
             let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             let mut count = 0u64;
             for y in y0..y1 {
@@ -101,15 +120,15 @@ pub fn render(
             rays.fetch_add(count, Ordering::Relaxed);
             let n = done.fetch_add(pixels.len() as u64, Ordering::Relaxed) + pixels.len() as u64;
             progress(n, total);
-            ((x0, y0), pixels)
+            ((x0, y0, x1 - x0), pixels)
         })
         .collect();
 
+    // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
     let mut film = Film::new(w, h);
-    for ((x0, y0), pixels) in rendered {
-        let tw = ((x0 + TILE).min(w) - x0) as usize;
+    for ((x0, y0, tw), pixels) in rendered {
         for (k, c) in pixels.into_iter().enumerate() {
-            let (x, y) = (x0 as usize + k % tw, y0 as usize + k / tw);
+            let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
             film.pixels[y * w as usize + x] = c;
         }
     }
@@ -121,6 +140,33 @@ pub fn render(
         }
         _ => None,
     };
-    let stats = RenderStats { rays: rays.into_inner(), time: start.elapsed(), spp, heatmap_max };
+    if (cx0, cy0, cx1, cy1) != (0, 0, w, h) {
+        film = cut(&film, cx0, cy0, cx1, cy1);
+    }
+    let cancelled = is_cancelled();
+    let stats = RenderStats { rays: rays.into_inner(), time: start.elapsed(), spp, heatmap_max, cancelled };
     (film, stats)
+}
+
+/// The crop window clamped to a `w` x `h` frame, as `(x0, y0, x1, y1)` with `x0 < x1`, `y0 < y1` unless the
+/// frame is empty; no crop is the whole frame.
+pub fn crop_window(crop: Option<(u32, u32, u32, u32)>, w: u32, h: u32) -> (u32, u32, u32, u32) {
+    match crop {
+        None => (0, 0, w, h),
+        Some((x0, y0, x1, y1)) => {
+            let (x1, y1) = (x1.min(w), y1.min(h));
+            (x0.min(x1.saturating_sub(1)), y0.min(y1.saturating_sub(1)), x1, y1)
+        }
+    }
+}
+
+/// The pixels `x0..x1` x `y0..y1` of `film`.
+fn cut(film: &Film, x0: u32, y0: u32, x1: u32, y1: u32) -> Film {
+    let mut out = Film::new(x1 - x0, y1 - y0);
+    for y in y0..y1 {
+        let row = (y * film.width) as usize;
+        let dst = ((y - y0) * out.width) as usize;
+        out.pixels[dst..dst + out.width as usize].copy_from_slice(&film.pixels[row + x0 as usize..row + x1 as usize]);
+    }
+    out
 }

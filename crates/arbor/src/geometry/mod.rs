@@ -1,5 +1,6 @@
 //! Shapes and their ray intersection: triangle meshes (flat arrays), spheres, infinite planes.
 
+pub mod error_bound;
 mod mesh;
 mod plane;
 mod sphere;

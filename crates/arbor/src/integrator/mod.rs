@@ -1,6 +1,7 @@
 //! Integrators: what colour a camera ray brings back.
 
 pub mod debug;
+pub mod offset;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};

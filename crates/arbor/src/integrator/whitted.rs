@@ -3,9 +3,11 @@
 //! dielectrics up to the recursion limit, with Beer's law along every segment travelled inside glass.
 //! Glass seen from inside gets no ambient or Blinn-Phong terms, only its lobes.
 //!
-//! Secondary ray origins are pushed off the surface by the scene's `ShadowRayEpsilon` along the
-//! geometric normal, to the side the new ray leaves from, so a ray never re-hits its own surface.
+//! Secondary ray origins are pushed off the surface to the side the new ray leaves from, so a ray never
+//! re-hits its own surface: by the scene's `ShadowRayEpsilon` or by the hit point's floating-point error
+//! bound ([`super::offset::spawn_origin`] decides).
 
+use super::offset::spawn_origin;
 use crate::light::sample_light;
 use crate::material::{beer, blinn_phong, specular_lobes};
 use crate::math::{Color, Ray};
@@ -43,14 +45,13 @@ impl<'a> Whitted<'a> {
         // Shade the side the ray arrives on: both normals are flipped towards it.
         let front = d.dot(s.ng) < 0.0;
         let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
-        let eps = scene.desc.shadow_epsilon;
 
         // A refractive surface hit from inside only refracts and reflects: its ambient and Blinn-Phong
         // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
         let local = front || !matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Transparent { .. });
         let mut color = if local { m.ambient * scene.desc.ambient } else { Color::ZERO };
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
-        let shadow_origin = s.p + ng * eps;
+        let shadow_origin = spawn_origin(&scene.desc, &s, ng);
         for light in scene.desc.lights.iter().filter(|_| local) {
             let Some(ls) = sample_light(light, s.p, rng.next_2d()) else { continue };
             if ns.dot(ls.wi) <= 0.0 {
@@ -77,8 +78,7 @@ impl<'a> Whitted<'a> {
                 if lobe.weight == Color::ZERO {
                     continue;
                 }
-                let leaves_front = lobe.dir.dot(s.ng) > 0.0;
-                let origin = s.p + if leaves_front { s.ng } else { -s.ng } * eps;
+                let origin = spawn_origin(&scene.desc, &s, lobe.dir);
                 // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
                 // a reflected one stays in whatever medium it was in.
                 let next_inside = match (lobe.transmitted, &m.kind) {

@@ -20,8 +20,11 @@ pub struct SceneDesc {
     /// Multiplies the scene's radiance to get display units (1.0 = white): 1/255 for the METU formats,
     /// whose colours are on a 0-255 scale; 1 for NYU.
     pub radiance_scale: f32,
-    /// Offset of secondary ray origins along the normal (`ShadowRayEpsilon`).
+    /// Offset of secondary ray origins along the normal (`ShadowRayEpsilon`), used when [`SceneDesc::offset`]
+    /// is [`OffsetRule::ShadowEpsilon`].
     pub shadow_epsilon: f32,
+    /// How secondary ray origins leave the surface.
+    pub offset: OffsetRule,
     /// `IntersectionTestEpsilon`, kept for reporting; the intersection tests are exact.
     pub intersection_epsilon: f32,
     /// Bounces of mirror, conductor and dielectric rays; 0 means none.
@@ -59,6 +62,7 @@ impl SceneDesc {
             background: Color::ZERO,
             radiance_scale: 1.0 / 255.0,
             shadow_epsilon: 1e-3,
+            offset: OffsetRule::ShadowEpsilon,
             intersection_epsilon: 1e-6,
             max_depth: 0,
             max_depth_loc: None,
@@ -74,6 +78,18 @@ impl SceneDesc {
             warnings: Vec::new(),
         }
     }
+}
+
+/// How far secondary rays (shadow, reflected, refracted) start from the surface they leave.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OffsetRule {
+    /// By [`SceneDesc::shadow_epsilon`] along the geometric normal: the METU formats always give one
+    /// (default 1e-3, the official renderer's), and their reference images depend on it.
+    #[default]
+    ShadowEpsilon,
+    /// By the floating-point error bound of the hit point, for scenes that give no epsilon (pbrt-v4's
+    /// `OffsetRayOrigin`, [`crate::geometry::error_bound`]).
+    ErrorBound,
 }
 
 /// The image-plane window `left right bottom top`, at `near_distance` along the gaze.

@@ -37,7 +37,10 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
     let top = Obj::new(&doc, "the scene", path)?;
     let mut desc = SceneDesc::new(path);
     desc.radiance_scale = 1.0;
+    // The format gives no epsilon: offsets follow the hit point's error bound (shadow_epsilon stays
+    // the 1e-4 reported before, unused).
     desc.shadow_epsilon = 1e-4;
+    desc.offset = super::desc::OffsetRule::ErrorBound;
     desc.max_depth = 0;
     desc.shadows = false;
     let mut warn = Vec::new();

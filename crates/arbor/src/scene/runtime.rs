@@ -5,8 +5,9 @@
 use std::time::{Duration, Instant};
 
 use super::build::{build_geometry, SceneGeometry, Shape};
-use super::desc::{MaterialDesc, SceneDesc};
+use super::desc::{MaterialDesc, OffsetRule, SceneDesc};
 use crate::accel::{AccelSpec, Hit};
+use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::math::{Ray, Vec3};
@@ -27,8 +28,11 @@ pub struct Scene {
 /// The shading data at a hit.
 #[derive(Debug, Clone, Copy)]
 pub struct Surface {
-    /// World-space point.
+    /// World-space point: `o + t d` under [`OffsetRule::ShadowEpsilon`]; recomputed from the surface's
+    /// own parameters (barycentrics, reprojection) under [`OffsetRule::ErrorBound`].
     pub p: Vec3,
+    /// Per-component bound on the error of `p` under [`OffsetRule::ErrorBound`] (zero otherwise).
+    pub p_error: Vec3,
     /// Unit geometric normal, outward (counter-clockwise side for triangles).
     pub ng: Vec3,
     /// Unit shading normal (interpolated for smooth meshes), on the same side as `ng`.
@@ -71,11 +75,20 @@ impl Scene {
     /// Shading data for `hit`, found on `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
         let g = &self.geometry;
-        let p = ray.at(hit.t);
+        let mut p = ray.at(hit.t);
+        let mut p_error = Vec3::ZERO;
+        let bound = self.desc.offset == OffsetRule::ErrorBound;
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
                 let (ng, ns) = match &o.shape {
                     Shape::Mesh(m) => {
+                        if bound {
+                            let (q, e) = triangle_point(m.mesh.triangle(hit.sub as usize), hit.u, hit.v);
+                            (p, p_error) = match &o.transform {
+                                None => (q, e),
+                                Some(t) => transform_point(t, q, e),
+                            };
+                        }
                         let (ng, ns) = triangle_normals(&m.mesh, hit);
                         match &o.transform {
                             None => (ng, ns),
@@ -87,6 +100,12 @@ impl Scene {
                         }
                     }
                     Shape::Sphere(s) => {
+                        if bound {
+                            let local = if s.transform.is_identity() { p } else { s.transform.inv.transform_point3(p) };
+                            let (q, e) = sphere_point(local, s.center, s.radius);
+                            (p, p_error) =
+                                if s.transform.is_identity() { (q, e) } else { transform_point(&s.transform, q, e) };
+                        }
                         let n = s.normal_at(p);
                         (n, n)
                     }
@@ -95,10 +114,13 @@ impl Scene {
             }
             None => {
                 let (plane, object) = &g.planes[hit.prim as usize - g.objects.objects.len()];
+                if bound {
+                    (p, p_error) = plane_point(p, plane.point, plane.normal);
+                }
                 (plane.normal, plane.normal, *object)
             }
         };
-        Surface { p, ng, ns, object, material: self.desc.objects[object as usize].material }
+        Surface { p, p_error, ng, ns, object, material: self.desc.objects[object as usize].material }
     }
 }
 

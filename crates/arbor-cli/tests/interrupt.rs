@@ -1,0 +1,106 @@
+//! No lost output: `arbor render` stopped by SIGINT or SIGTERM exits 130 or 143 and leaves the output
+//! folder as it was (no new image, no temporary file, an older image unchanged). Also `--crop`: the
+//! cropped image equals the same window of the full render.
+
+#![cfg(unix)]
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const ARBOR: &str = env!("CARGO_BIN_EXE_arbor");
+
+/// `arbor render` of the built-in example at many samples per pixel: minutes of work, so a signal sent
+/// after a moment always lands during the run.
+fn start_long_render(out: &Path) -> Child {
+    Command::new(ARBOR)
+        .args(["render", "--quiet", "--spp", "2000", "--threads", "2", "-o"])
+        .arg(out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Sends `signal` (a `kill` name) after `delay`; returns the exit code, failing after 60 s.
+fn signal_and_wait(mut child: Child, signal: &str, delay: Duration) -> Option<i32> {
+    std::thread::sleep(delay);
+    let sent = Command::new("kill").arg(format!("-{signal}")).arg(child.id().to_string()).status().unwrap();
+    assert!(sent.success(), "kill -{signal} failed");
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status.code();
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("arbor render did not stop within 60 s of SIG{signal}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn interrupt_sigint_exits_130_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let code = signal_and_wait(start_long_render(tmp.path()), "INT", Duration::from_millis(1500));
+    assert_eq!(code, Some(130));
+    assert!(entries(tmp.path()).is_empty(), "left behind: {:?}", entries(tmp.path()));
+}
+
+#[test]
+fn interrupt_sigterm_exits_143_and_keeps_the_older_image() {
+    let tmp = tempfile::tempdir().unwrap();
+    let old = tmp.path().join("cornell_box.png");
+    std::fs::write(&old, b"an older image").unwrap();
+    let code = signal_and_wait(start_long_render(tmp.path()), "TERM", Duration::from_millis(1500));
+    assert_eq!(code, Some(143));
+    assert_eq!(entries(tmp.path()), ["cornell_box.png"]);
+    assert_eq!(std::fs::read(&old).unwrap(), b"an older image");
+}
+
+#[test]
+fn interrupt_sigint_keeps_the_older_image() {
+    let tmp = tempfile::tempdir().unwrap();
+    let old = tmp.path().join("cornell_box.png");
+    std::fs::write(&old, b"an older image").unwrap();
+    // Early: possibly still while the scene is being built.
+    let code = signal_and_wait(start_long_render(tmp.path()), "INT", Duration::from_millis(300));
+    assert_eq!(code, Some(130));
+    assert_eq!(entries(tmp.path()), ["cornell_box.png"]);
+    assert_eq!(std::fs::read(&old).unwrap(), b"an older image");
+}
+
+fn render_png(out: &Path, extra: &[&str]) -> (u32, u32, Vec<u8>) {
+    let status =
+        Command::new(ARBOR).args(["render", "--quiet", "--spp", "2", "-o"]).arg(out).args(extra).status().unwrap();
+    assert!(status.success(), "arbor render {extra:?}: {status}");
+    arbor::image_io::read_rgb8(&out.join("cornell_box.png")).unwrap()
+}
+
+#[test]
+fn crop_equals_the_window_of_the_full_render() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (w, _, full) = render_png(&tmp.path().join("full"), &[]);
+    // Not aligned to the 16-pixel tiles.
+    let (x0, y0, x1, y1) = (37u32, 101u32, 130u32, 140u32);
+    let (cw, ch, crop) = render_png(&tmp.path().join("crop"), &["--crop", "37,101,130,140", "--threads", "1"]);
+    assert_eq!((cw, ch), (x1 - x0, y1 - y0));
+    for y in 0..ch {
+        let src = (((y0 + y) * w + x0) * 3) as usize;
+        let dst = (y * cw * 3) as usize;
+        assert_eq!(&crop[dst..dst + (cw * 3) as usize], &full[src..src + (cw * 3) as usize], "row {y}");
+    }
+    let bad = Command::new(ARBOR).args(["render", "--quiet", "--crop", "0,0,401,10", "-o"]).arg(tmp.path()).output();
+    let bad = bad.unwrap();
+    assert_eq!(bad.status.code(), Some(3), "{}", String::from_utf8_lossy(&bad.stderr));
+    let empty = Command::new(ARBOR).args(["render", "--crop", "5,5,5,9"]).output().unwrap();
+    assert_eq!(empty.status.code(), Some(2));
+}
