@@ -1,0 +1,89 @@
+//! Inputs found by the fuzz targets (`fuzz/`, see `docs/robustness.md`) that once made a reader or a
+//! structure panic or disagree, kept here with their bytes inline so `cargo test` replays them; and a
+//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files, so every run starts from inputs that
+//! reach past the first error.
+
+use std::path::{Path, PathBuf};
+
+use arbor::mesh_io::{parse_obj, parse_off, parse_ply};
+use arbor::scene::parse_desc;
+
+fn seeds(target: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds").join(target);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no seeds in {}", dir.display());
+    files
+}
+
+#[test]
+fn fuzz_seeds_are_valid_meshes() {
+    type Reader = fn(&[u8], &Path) -> arbor::Result<arbor::geometry::TriangleMesh>;
+    let readers: [(&str, Reader); 4] = [
+        ("parse_ply_ascii", parse_ply),
+        ("parse_ply_binary", parse_ply),
+        ("parse_obj", parse_obj),
+        ("parse_off", parse_off),
+    ];
+    for (target, read) in readers {
+        for f in seeds(target) {
+            let mesh = read(&std::fs::read(&f).unwrap(), &f).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(!mesh.is_empty(), "seed {} has no triangle", f.display());
+        }
+    }
+}
+
+#[test]
+fn fuzz_binary_ply_seeds_match_the_ascii_pyramid() {
+    let ascii = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/square_pyramid.ply");
+    let want = parse_ply(&std::fs::read(&ascii).unwrap(), &ascii).unwrap();
+    for f in seeds("parse_ply_binary") {
+        let got = parse_ply(&std::fs::read(&f).unwrap(), &f).unwrap();
+        assert_eq!(
+            (&got.positions, &got.indices, &got.normals),
+            (&want.positions, &want.indices, &want.normals),
+            "{}",
+            f.display()
+        );
+    }
+}
+
+#[test]
+fn fuzz_seeds_are_valid_scenes() {
+    for target in ["parse_metu_xml", "parse_metu_json", "parse_nyu_json"] {
+        for f in seeds(target) {
+            let text = std::fs::read_to_string(&f).unwrap();
+            // The targets read the text as `fuzz.xml`, `fuzz.json` and `scene.json`.
+            let name = if target == "parse_metu_xml" { "fuzz.xml" } else { "scene.json" };
+            let d = parse_desc(&text, Path::new(name)).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(!d.objects.is_empty(), "seed {} has no object", f.display());
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// accel_differential
+
+/// Found by `accel_differential` (minimised): a triangle with one huge corner, hit at `t` when `t_max`
+/// is infinite, but not when `t_max` is the next float above that same `t`. So `occluded(t_max)` is
+/// false although `intersect` reports a hit below `t_max`, in every structure and in brute force alike.
+///
+/// Cause: `intersect_triangle` (geometry/triangle.rs) rejects early on the scaled test
+/// `t_scaled > t_max * det` (pbrt's), but reports `t = t_scaled * (1 / det)`; the two roundings disagree
+/// by an ulp, so a `t_max` just above the reported `t` rejects the hit. Fix (geometry owner): decide
+/// only on the reported `t` (keep the sign tests on `t_scaled`, let `!(t < t_max)` decide the far end).
+#[test]
+#[ignore = "known bug in geometry::intersect_triangle, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_triangle_hit_below_t_max_is_reported_at_t_max() {
+    use arbor::geometry::intersect_triangle;
+    use arbor::math::{Ray, Vec3};
+    let ray = Ray::new(Vec3::new(1.0, 0.0, 0.0), Vec3::new(-1.0, -30.0, -30.0));
+    let tri = [Vec3::splat(-30.0), Vec3::new(4.253_737e37, -29.75, -30.0), Vec3::new(0.0, -5.75, 0.0)];
+    let hit = intersect_triangle(&ray, tri[0], tri[1], tri[2], f32::INFINITY).expect("hit with an infinite t_max");
+    let above = f32::from_bits(hit.t.to_bits() + 1);
+    let again = intersect_triangle(&ray, tri[0], tri[1], tri[2], above);
+    assert_eq!(again.map(|h| h.t), Some(hit.t), "hit at t {} but none with t_max {above}", hit.t);
+}
