@@ -146,3 +146,26 @@ fn fuzz_accel_huge_direction_tiny_t() {
     let failures = differential(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Found by `accel_differential` (third session run; minimised by hand): a ray aimed exactly at the
+/// vertex (0, 0, 1), shared by triangles 5 and 6, from an origin with a subnormal z, in a soup with one
+/// huge corner (z = 5.2e36). Brute force hits triangle 5 at t = 0.99999994; the octree and the kd-tree
+/// return triangle 6 at t = 0.9999999, one ulp farther, so they lose the closest hit. Cause not
+/// diagnosed in the fuzzing session (the huge corner makes the root box, and so the cells, enormous
+/// along z; the pruning margin is taken on the ray's major axis, x).
+#[test]
+#[ignore = "known bug in the octree and kd-tree traversal, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
+    let verts = [
+        [-30.0, -30.0, 5.1605320697943087e+36],
+        [0.0, 0.0, 1.0],
+        [-30.0, 1.0, -30.0],
+        [-30.0, -29.75, -29.25],
+        [-28.5, -29.5, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let tris = [[0, 3, 0], [0, 4, 4], [0, 0, 2], [0, 0, 0], [0, 0, 2], [3, 5, 2], [0, 3, 5]];
+    let rays = [([-30.0, 8.25, 1.6535321879032841e-43], [30.0, -8.25, 1.0], f32::INFINITY)];
+    let failures = differential(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
