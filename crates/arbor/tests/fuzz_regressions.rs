@@ -1,0 +1,186 @@
+//! Inputs found by the fuzz targets (`fuzz/`, see `docs/robustness.md`) that once made a reader or a
+//! structure panic or disagree, kept here with their bytes inline so `cargo test` replays them; and a
+//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files, so every run starts from inputs that
+//! reach past the first error.
+
+use std::path::{Path, PathBuf};
+
+use arbor::mesh_io::{parse_obj, parse_off, parse_ply};
+use arbor::scene::parse_desc;
+
+fn seeds(target: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds").join(target);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no seeds in {}", dir.display());
+    files
+}
+
+#[test]
+fn fuzz_seeds_are_valid_meshes() {
+    type Reader = fn(&[u8], &Path) -> arbor::Result<arbor::geometry::TriangleMesh>;
+    let readers: [(&str, Reader); 4] = [
+        ("parse_ply_ascii", parse_ply),
+        ("parse_ply_binary", parse_ply),
+        ("parse_obj", parse_obj),
+        ("parse_off", parse_off),
+    ];
+    for (target, read) in readers {
+        for f in seeds(target) {
+            let mesh = read(&std::fs::read(&f).unwrap(), &f).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(!mesh.is_empty(), "seed {} has no triangle", f.display());
+        }
+    }
+}
+
+#[test]
+fn fuzz_binary_ply_seeds_match_the_ascii_pyramid() {
+    let ascii = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/square_pyramid.ply");
+    let want = parse_ply(&std::fs::read(&ascii).unwrap(), &ascii).unwrap();
+    for f in seeds("parse_ply_binary") {
+        let got = parse_ply(&std::fs::read(&f).unwrap(), &f).unwrap();
+        assert_eq!(
+            (&got.positions, &got.indices, &got.normals),
+            (&want.positions, &want.indices, &want.normals),
+            "{}",
+            f.display()
+        );
+    }
+}
+
+#[test]
+fn fuzz_seeds_are_valid_scenes() {
+    for target in ["parse_metu_xml", "parse_metu_json", "parse_nyu_json"] {
+        for f in seeds(target) {
+            let text = std::fs::read_to_string(&f).unwrap();
+            // The targets read the text as `fuzz.xml`, `fuzz.json` and `scene.json`.
+            let name = if target == "parse_metu_xml" { "fuzz.xml" } else { "scene.json" };
+            let d = parse_desc(&text, Path::new(name)).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(!d.objects.is_empty(), "seed {} has no object", f.display());
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// accel_differential
+
+/// Found by `accel_differential` (minimised): a triangle with one huge corner, hit at `t` when `t_max`
+/// is infinite, but not when `t_max` is the next float above that same `t`. So `occluded(t_max)` is
+/// false although `intersect` reports a hit below `t_max`, in every structure and in brute force alike.
+///
+/// Cause: `intersect_triangle` (geometry/triangle.rs) rejects early on the scaled test
+/// `t_scaled > t_max * det` (pbrt's), but reports `t = t_scaled * (1 / det)`; the two roundings disagree
+/// by an ulp, so a `t_max` just above the reported `t` rejects the hit. Fix (geometry owner): decide
+/// only on the reported `t` (keep the sign tests on `t_scaled`, let `!(t < t_max)` decide the far end).
+#[test]
+#[ignore = "known bug in geometry::intersect_triangle, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_triangle_hit_below_t_max_is_reported_at_t_max() {
+    use arbor::geometry::intersect_triangle;
+    use arbor::math::{Ray, Vec3};
+    let ray = Ray::new(Vec3::new(1.0, 0.0, 0.0), Vec3::new(-1.0, -30.0, -30.0));
+    let tri = [Vec3::splat(-30.0), Vec3::new(4.253_737e37, -29.75, -30.0), Vec3::new(0.0, -5.75, 0.0)];
+    let hit = intersect_triangle(&ray, tri[0], tri[1], tri[2], f32::INFINITY).expect("hit with an infinite t_max");
+    let above = f32::from_bits(hit.t.to_bits() + 1);
+    let again = intersect_triangle(&ray, tri[0], tri[1], tri[2], above);
+    assert_eq!(again.map(|h| h.t), Some(hit.t), "hit at t {} but none with t_max {above}", hit.t);
+}
+
+/// Every structure against brute force on `rays` over the triangle soup `verts`/`tris` (exact: same
+/// `Option`, primitive and `t` bits, same `occluded`), as `accel_differential` checks. Returns the
+/// failures, one line each.
+fn differential(verts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[([f32; 3], [f32; 3], f32)]) -> Vec<String> {
+    use arbor::accel::{build, AccelKind};
+    use arbor::geometry::TriangleMesh;
+    use arbor::math::{Ray, Vec3};
+    let mesh = TriangleMesh {
+        positions: verts.iter().map(|&v| Vec3::from(v)).collect(),
+        indices: tris.to_vec(),
+        ..Default::default()
+    };
+    let brute = build(AccelKind::Brute, &mesh);
+    let mut failures = Vec::new();
+    for &kind in AccelKind::ALL {
+        let accel = build(kind, &mesh);
+        for &(o, d, t_max) in rays {
+            let ray = Ray::new(Vec3::from(o), Vec3::from(d));
+            let (want, got) = (brute.intersect(&mesh, &ray, t_max), accel.intersect(&mesh, &ray, t_max));
+            if want.map(|h| (h.prim, h.t.to_bits())) != got.map(|h| (h.prim, h.t.to_bits())) {
+                failures.push(format!("{kind}: {ray:?} t_max {t_max}: hit {got:?}, brute force {want:?}"));
+            }
+            let (want, got) = (brute.occluded(&mesh, &ray, t_max), accel.occluded(&mesh, &ray, t_max));
+            if want != got {
+                failures.push(format!("{kind}: {ray:?} t_max {t_max}: occluded {got}, brute force {want}"));
+            }
+        }
+    }
+    failures
+}
+
+/// Found by `accel_differential` (minimised by libFuzzer, then by hand): a ray with a huge direction
+/// (|d| ~ 2e34) starting 2e-34 on the negative side of the plane x = 0, which brute force hits at
+/// `t` ~ 1.3e-33 on a triangle lying in x >= 0; the kd-tree misses it (and answers `occluded` false).
+///
+/// Cause: `kdtree/traverse.rs`, `Clipped::children`: the plane's distance
+/// `t_split = (split - origin[a]) * inv_dir[a]` = 2.04e-34 * 5.9e-24 underflows to +0, and `t_split <= 0.0`
+/// is read as "the ray moves away from the second child" (the comment there says the sign is exact; the
+/// difference's sign is, the product's is not once it underflows), so the child holding the triangle is
+/// never visited. Fix (accel owner): decide "moving away" from the signs of `split - origin[a]` and
+/// `dir[a]`, and clamp an underflowed `t_split` to the interval.
+#[test]
+#[ignore = "known bug in the kd-tree's traversal, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_accel_huge_direction_tiny_t() {
+    // Triangle 0 is the one hit; the other three only make the kd-tree split (two are degenerate).
+    let verts = [
+        [0.0, 0.0, 0.0],
+        [0.0, 1.0, -30.0],
+        [1.0, 0.0, -30.0],
+        [-30.0, -30.0, -14.5],
+        [1.0, -30.0, -29.75],
+        [-29.5, -30.0, -13.75],
+    ];
+    let tris = [[2, 1, 0], [0, 2, 0], [5, 2, 4], [0, 0, 0]];
+    let rays = [([-2.0389849502874925e-34, -26.25, -4.5], [1.6938020184141926e+23, 2.032059015034331e+34, -0.25], 1.0)];
+    let failures = differential(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Found by `accel_differential` (third session run; minimised by hand): a ray aimed exactly at the
+/// vertex (0, 0, 1), shared by triangles 5 and 6, from an origin with a subnormal z, in a soup with one
+/// huge corner (z = 5.2e36). Brute force hits triangle 5 at t = 0.99999994; the octree and the kd-tree
+/// return triangle 6 at t = 0.9999999, one ulp farther, so they lose the closest hit. Cause not
+/// diagnosed in the fuzzing session (the huge corner makes the root box, and so the cells, enormous
+/// along z; the pruning margin is taken on the ray's major axis, x).
+#[test]
+#[ignore = "known bug in the octree and kd-tree traversal, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
+    let verts = [
+        [-30.0, -30.0, 5.1605320697943087e+36],
+        [0.0, 0.0, 1.0],
+        [-30.0, 1.0, -30.0],
+        [-30.0, -29.75, -29.25],
+        [-28.5, -29.5, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let tris = [[0, 3, 0], [0, 4, 4], [0, 0, 2], [0, 0, 0], [0, 0, 2], [3, 5, 2], [0, 3, 5]];
+    let rays = [([-30.0, 8.25, 1.6535321879032841e-43], [30.0, -8.25, 1.0], f32::INFINITY)];
+    let failures = differential(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Found by `accel_differential` (loop run 3; `fuzz/crashes/accel_differential/crash-7697...`, reduced to
+/// its failing ray): a ray whose x direction is subnormal (`inv_dir.x` = -inf), starting at a subnormal x,
+/// aimed at the vertex (0, 0, 1): brute force hits triangle 1, the kd-tree reports no hit. Cause not
+/// diagnosed in the fuzzing session; probably the same family as `fuzz_accel_huge_direction_tiny_t` (a
+/// plane distance that is infinite or underflowed, read as a direction).
+#[test]
+#[ignore = "known bug in the kd-tree's traversal, reported from the fuzzing work; un-ignore with the fix"]
+fn fuzz_accel_subnormal_direction() {
+    let verts = [[-16.5, -30.0, -30.0], [-29.75, 1.5, -30.0], [-30.0, -30.0, -30.0], [0.0, 0.0, 1.0]];
+    let tris = [[0, 1, 2], [2, 1, 3]];
+    let rays = [([6.887942471542206e-41, -30.0, -30.0], [-6.887942471542206e-41, 30.0, 31.0], f32::INFINITY)];
+    let failures = differential(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -1,0 +1,13 @@
+//! PLY in ASCII: `arbor::mesh_io::parse_ply` on any bytes, seeded with ASCII files (fuzz/seeds/parse_ply_ascii).
+
+#![no_main]
+
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(mesh) = arbor::mesh_io::parse_ply(data, std::path::Path::new("fuzz.ply")) {
+        common::check_mesh(&mesh, "ply_ascii");
+    }
+});
