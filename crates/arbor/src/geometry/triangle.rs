@@ -78,10 +78,14 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     b.z *= sz;
     c.z *= sz;
     let t_scaled = e0 * a.z + e1 * b.z + e2 * c.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+    // Early outs on the scaled t. The far one is widened by a few ulps: `t_max * det` and the final
+    // `t_scaled * (1 / det)` round differently, and only the final `t < t_max` may decide, or a hit at
+    // `t` would vanish for `t_max` just above `t` (found by fuzzing; structures query exactly there).
+    let far = t_max * det * (1.0 + 4.0 * f32::EPSILON);
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < far) {
         return None;
     }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > far) {
         return None;
     }
     let inv_det = 1.0 / det;
