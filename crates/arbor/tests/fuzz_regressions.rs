@@ -126,10 +126,8 @@ fn differential(verts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[([f32; 3], [f32; 
 /// `t_split = (split - origin[a]) * inv_dir[a]` = 2.04e-34 * 5.9e-24 underflows to +0, and `t_split <= 0.0`
 /// is read as "the ray moves away from the second child" (the comment there says the sign is exact; the
 /// difference's sign is, the product's is not once it underflows), so the child holding the triangle is
-/// never visited. Fix (accel owner): decide "moving away" from the signs of `split - origin[a]` and
-/// `dir[a]`, and clamp an underflowed `t_split` to the interval.
+/// never visited. Fixed: "moving away" is decided from the signs of `split - origin[a]` and `dir[a]`.
 #[test]
-#[ignore = "known bug in the kd-tree's traversal, reported from the fuzzing work; un-ignore with the fix"]
 fn fuzz_accel_huge_direction_tiny_t() {
     // Triangle 0 is the one hit; the other three only make the kd-tree split (two are degenerate).
     let verts = [
@@ -153,7 +151,6 @@ fn fuzz_accel_huge_direction_tiny_t() {
 /// diagnosed in the fuzzing session (the huge corner makes the root box, and so the cells, enormous
 /// along z; the pruning margin is taken on the ray's major axis, x).
 #[test]
-#[ignore = "known bug in the octree and kd-tree traversal, reported from the fuzzing work; un-ignore with the fix"]
 fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
     let verts = [
         [-30.0, -30.0, 5.1605320697943087e+36],

@@ -82,6 +82,15 @@ impl Clipped {
         Some(Clipped { origin, dir, inv_dir, root: Todo { node: 0, t_min: near, t_max: far }, margin })
     }
 
+    /// Whether the ray moves towards the plane `split` on axis `a` (so may reach its far side). Decided
+    /// by signs, which are exact: `t_split` itself can underflow to +0 for a tiny distance times a tiny
+    /// reciprocal direction, and must not be read as "moving away" (found by fuzzing).
+    #[inline]
+    fn toward(&self, a: usize, split: f32) -> bool {
+        let (o, d) = (self.origin[a], self.dir[a]);
+        (o < split && d > 0.0) || (o > split && d < 0.0)
+    }
+
     /// The children of inner node `at.node` the ray meets: the near one to visit now, the far one (if
     /// met too) to push.
     #[inline]
@@ -96,9 +105,7 @@ impl Clipped {
         if t_split.is_nan() {
             // Origin in the plane, ray parallel to it: it runs along both children.
             (whole(first), Some(whole(second)))
-        } else if t_split > at.t_max + self.margin || t_split <= 0.0 {
-            // The sign of `t_split` is exact (the sign of a float difference is), so `<= 0` means the
-            // ray moves away from the second child.
+        } else if t_split > at.t_max + self.margin || !self.toward(a, split) {
             (whole(first), None)
         } else if t_split < at.t_min - self.margin {
             (whole(second), None)
