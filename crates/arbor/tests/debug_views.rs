@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use arbor::accel::{AccelKind, AccelSpec, TraversalCounts};
@@ -15,7 +15,7 @@ use arbor::integrator::debug::{false_color, legend_rows, overlay_boxes, BOX_COLO
 use arbor::integrator::DebugView;
 use arbor::math::{Aabb, Color, Vec3};
 use arbor::render::{render, RenderOptions};
-use arbor::scene::{load_desc, CameraDesc, MeshSource, Scene, SceneDesc, ShapeDesc, Window};
+use arbor::scene::{load_desc, CameraDesc, Scene, SceneDesc, ShapeDesc, Window};
 
 /// Primitive tests (plus nodes) one structure may spend on one reference-scene image; beyond it (brute
 /// force on large scenes) only an evenly spaced sample of pixels is compared.
@@ -56,27 +56,6 @@ fn debug_primid_identical_across_structures_on_generated_mesh() {
     assert!(alone.to_rgb8() == bytes, "primid image depends on the thread count");
 }
 
-fn scene_files(dir: &Path, ext: &str) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
-            let p = entry.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|e| e == ext) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-fn has_missing_mesh(desc: &SceneDesc) -> bool {
-    desc.objects.iter().any(|o| matches!(&o.shape, ShapeDesc::Mesh { source: MeshSource::File(p), .. } if !p.is_file()))
-}
-
 /// Estimated work of a primid render: the mean traversal cost of a sample of the camera's rays times
 /// the pixel count.
 fn estimated_work(scene: &Scene) -> f64 {
@@ -95,12 +74,12 @@ fn estimated_work(scene: &Scene) -> f64 {
 fn debug_primid_identical_across_structures_on_reference_scenes() {
     let Some(dir) = common::scenes_dir() else { return };
     let start = Instant::now();
-    let mut scenes = scene_files(&dir.join("ceng795-2024-hw1/hw1/inputs"), "xml");
-    scenes.extend(scene_files(&dir.join("ceng795-2025-json/hw1/inputs"), "json"));
+    let mut scenes = common::scene_files(&dir.join("ceng795-2024-hw1/hw1/inputs"), "xml");
+    scenes.extend(common::scene_files(&dir.join("ceng795-2025-json/hw1/inputs"), "json"));
     let (mut compared, mut skipped, mut failures, mut sampled_note) = (0, Vec::new(), Vec::new(), Vec::new());
     for path in &scenes {
         let mut desc = load_desc(path).unwrap_or_else(|e| panic!("{e}"));
-        if has_missing_mesh(&desc) || desc.cameras.is_empty() {
+        if !common::missing_mesh_files(&desc).is_empty() || desc.cameras.is_empty() {
             skipped.push(format!("{} (missing mesh file or camera)", path.display()));
             continue;
         }

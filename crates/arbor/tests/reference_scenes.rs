@@ -19,7 +19,7 @@ use arbor::accel::{AccelKind, AccelSpec};
 use arbor::image_io::metrics::compare_rgb8;
 use arbor::image_io::read_rgb8;
 use arbor::render::{render, RenderOptions};
-use arbor::scene::{load_desc, MeshSource, Scene, SceneDesc, ShapeDesc};
+use arbor::scene::{load_desc, Scene};
 
 const THRESHOLD: u8 = 8;
 const MAX_SHARE_OFF: f64 = 0.005;
@@ -30,34 +30,6 @@ struct Case {
     camera: usize,
     reference: PathBuf,
     cull: bool,
-}
-
-fn scene_files(dir: &Path, ext: &str) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = entry.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|e| e == ext) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-/// The mesh files a scene needs that are not there.
-fn missing_files(desc: &SceneDesc) -> Vec<PathBuf> {
-    desc.objects
-        .iter()
-        .filter_map(|o| match &o.shape {
-            ShapeDesc::Mesh { source: MeshSource::File(p), .. } if !p.is_file() => Some(p.clone()),
-            _ => None,
-        })
-        .collect()
 }
 
 /// The reference of camera `camera` of `scene` in `outputs` (same sub-folder, image name as PNG).
@@ -129,9 +101,9 @@ fn check(failures: Vec<String>) {
 fn metu_cases(root: &Path, ext: &str, refs: &[(&str, bool)]) -> (Vec<Case>, Vec<String>) {
     let inputs = root.join("inputs");
     let (mut cases, mut skipped) = (Vec::new(), Vec::new());
-    for scene in scene_files(&inputs, ext) {
+    for scene in common::scene_files(&inputs, ext) {
         let desc = load_desc(&scene).unwrap_or_else(|e| panic!("{e}"));
-        let missing = missing_files(&desc);
+        let missing = common::missing_mesh_files(&desc);
         if !missing.is_empty() {
             let names: Vec<String> = missing.iter().map(|p| p.display().to_string()).collect();
             skipped.push(format!("{} (missing {})", scene.display(), names.join(", ")));

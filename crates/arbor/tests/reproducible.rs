@@ -10,38 +10,14 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use arbor::accel::{AccelKind, AccelSpec};
 use arbor::film::Film;
 use arbor::render::{render, RenderOptions};
-use arbor::scene::{load_desc, parse_desc, MeshSource, Scene, SceneDesc, ShapeDesc};
+use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
 
 const DIVISOR: u32 = 3;
-
-fn scene_files(dir: &Path, ext: &str) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap().flatten() {
-            let p = entry.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|e| e == ext) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-fn complete(desc: &SceneDesc) -> bool {
-    desc.objects.iter().all(|o| match &o.shape {
-        ShapeDesc::Mesh { source: MeshSource::File(p), .. } => p.is_file(),
-        _ => true,
-    })
-}
 
 fn shrink(mut desc: SceneDesc, divisor: u32) -> SceneDesc {
     for c in &mut desc.cameras {
@@ -80,12 +56,12 @@ fn compare_threads(name: &str, desc: SceneDesc, opts: &RenderOptions) -> Vec<Str
 #[test]
 fn reproducible_shared_scenes_for_1_and_2_threads() {
     let Some(dir) = common::scenes_dir() else { return };
-    let mut scenes = scene_files(&dir.join("ceng795-2024-hw1/hw1/inputs"), "xml");
-    scenes.extend(scene_files(&dir.join("ceng795-2025-json/hw1/inputs"), "json"));
+    let mut scenes = common::scene_files(&dir.join("ceng795-2024-hw1/hw1/inputs"), "xml");
+    scenes.extend(common::scene_files(&dir.join("ceng795-2025-json/hw1/inputs"), "json"));
     let (mut differ, mut rendered) = (Vec::new(), 0);
     for path in &scenes {
         let desc = load_desc(path).unwrap_or_else(|e| panic!("{e}"));
-        if !complete(&desc) {
+        if !common::missing_mesh_files(&desc).is_empty() {
             println!("SKIPPED {} (missing meshes)", path.display());
             continue;
         }
@@ -112,7 +88,7 @@ fn reproducible_area_light_with_many_samples() {
     let Some(dir) = common::scenes_dir() else { return };
     let path = dir.join("ceng795-2019/inputs/hw2/cornellbox_area.xml");
     let desc = load_desc(&path).unwrap_or_else(|e| panic!("{e}"));
-    assert!(complete(&desc));
+    assert!(common::missing_mesh_files(&desc).is_empty());
     let opts = RenderOptions { spp: Some(4), ..Default::default() };
     let differ = compare_threads("cornellbox_area", shrink(desc, 8), &opts);
     assert!(differ.is_empty(), "{differ:?}");

@@ -266,30 +266,14 @@ fn readers_nyu_parallelogram_and_located_errors() {
     );
 }
 
-/// Every `.xml` and `.json` under `dir`, sorted.
-fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            scene_files(&p, out);
-        } else if matches!(p.extension().and_then(|e| e.to_str()), Some("xml" | "json")) {
-            out.push(p);
-        }
-    }
-    out.sort();
-}
-
 /// With `ARBOR_PRINT_WARNINGS` set (and `--nocapture`), prints every warning of every scene.
 #[test]
 fn readers_load_every_shared_scene() {
     let Some(dir) = common::scenes_dir() else {
         return;
     };
-    let mut files = Vec::new();
-    scene_files(&dir, &mut files);
+    let mut files = common::scene_files(&dir, "xml");
+    files.extend(common::scene_files(&dir, "json"));
     assert!(files.len() > 80, "only {} scene files under {}", files.len(), dir.display());
     let failures: Vec<String> = files
         .iter()
@@ -357,8 +341,7 @@ fn readers_shared_xml_and_json_twins_agree() {
     };
     let xml_dir = dir.join("ceng795-2024-hw1/hw1/inputs");
     let json_dir = dir.join("ceng795-2025-json/hw1/inputs");
-    let mut files = Vec::new();
-    scene_files(&xml_dir, &mut files);
+    let files = common::scene_files(&xml_dir, "xml");
     let mut compared = 0;
     for x in files {
         let rel = x.strip_prefix(&xml_dir).unwrap().with_extension("json");

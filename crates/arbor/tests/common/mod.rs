@@ -1,7 +1,9 @@
 //! Helpers shared by the integration tests: where the shared real-world data lives.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use arbor::scene::{MeshSource, SceneDesc, ShapeDesc};
 
 /// The folder of shared reference scenes: `$ARBOR_SCENES`, or `../shared/scenes` beside the checkout.
 ///
@@ -30,4 +32,33 @@ fn shared_dir(var: &str, name: &str) -> Option<PathBuf> {
     }
     eprintln!("SKIPPED: {msg}");
     None
+}
+
+/// Every file with extension `ext` below `dir`, sorted (none when `dir` cannot be read).
+pub fn scene_files(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = entry.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|e| e == ext) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The mesh files a scene names that are not there (the shared snapshot lacks files of 4 MiB or more).
+pub fn missing_mesh_files(desc: &SceneDesc) -> Vec<PathBuf> {
+    desc.objects
+        .iter()
+        .filter_map(|o| match &o.shape {
+            ShapeDesc::Mesh { source: MeshSource::File(p), .. } if !p.is_file() => Some(p.clone()),
+            _ => None,
+        })
+        .collect()
 }
