@@ -252,6 +252,7 @@ const CLOSED_MESH_RAYS: usize = 50_000;
 const DUPLICATE_RAYS: usize = 100_000;
 const DEGENERATE_RAYS: usize = 80_000;
 const AXIS_RAYS: usize = 100_000;
+const SUBNORMAL_RAYS: usize = 50_000;
 const MIXED_RAYS: usize = 100_000;
 const TINY_SET_RAYS: usize = 3 * 10_000;
 const NAN_RAYS: usize = 8 * 9;
@@ -267,6 +268,7 @@ fn conformance_casts_a_million_rays_per_structure() {
         + DUPLICATE_RAYS
         + DEGENERATE_RAYS
         + AXIS_RAYS
+        + SUBNORMAL_RAYS
         + MIXED_RAYS
         + TINY_SET_RAYS
         + NAN_RAYS
@@ -434,6 +436,49 @@ fn accel_matches_brute_force_on_rays_along_the_axes() {
         })
         .collect();
     assert!(check("axis rays", &mesh, &probes) >= AXIS_RAYS);
+}
+
+/// Rays whose direction has subnormal components (reciprocals overflow to infinity), from points a
+/// subnormal distance off vertices and box planes, and rays with huge directions: the slab tests must
+/// not put a box met at a finite `t` at infinity (a fuzz finding, `tests/fuzz_regressions.rs`).
+#[test]
+fn accel_matches_brute_force_on_rays_with_subnormal_components() {
+    let mut rng = Rng::new(710);
+    let mut tris = random_soup(&mut rng, 200, 10.0, 3.0);
+    tris.extend(grid(3, 2));
+    let mesh = mesh_of(&tris);
+    let targets = Targets::of(&mesh, &tris.concat());
+    let around = targets.around();
+    let subnormal = |rng: &mut Rng| {
+        let s = f32::from_bits(1 + rng.u32() % 0x007f_ffff);
+        if rng.below(2) == 0 {
+            s
+        } else {
+            -s
+        }
+    };
+    let probes: Vec<_> = (0..SUBNORMAL_RAYS)
+        .map(|_| {
+            let target = rng.pick(&targets.points);
+            let mut o = if rng.below(2) == 0 { rng.in_box(&around) } else { target };
+            let mut d = target - o;
+            if d == Vec3::ZERO {
+                d = rng.vec3() - 0.5;
+            }
+            for a in 0..3 {
+                match rng.below(4) {
+                    0 => d[a] = subnormal(&mut rng),
+                    1 => o[a] = target[a] + subnormal(&mut rng),
+                    _ => {}
+                }
+            }
+            if rng.below(8) == 0 {
+                d *= 1e30;
+            }
+            Probe { ray: Ray::new(o, d), t_max: f32::INFINITY }
+        })
+        .collect();
+    assert!(check("subnormal rays", &mesh, &probes) >= SUBNORMAL_RAYS);
 }
 
 /// The surface of the cube `[0, n]^3` as unit squares: closed, so every ray from inside hits it.

@@ -17,8 +17,16 @@ pub struct Ray {
 
 impl Ray {
     /// A ray that sees both sides of triangles.
+    ///
+    /// Subnormal direction components are flushed to zero (keeping their sign): the reciprocal of one
+    /// below `1 / f32::MAX` overflows to infinity, and a slab test that multiplies by it would then put
+    /// a box met at a finite `t` at infinity and miss hits that brute force finds (found by fuzzing).
+    /// The change moves the ray by less than any representable distance relative to its other
+    /// components, and every structure, brute force included, sees the same flushed ray.
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        let tiny = dir.abs().cmplt(Vec3::splat(f32::MIN_POSITIVE));
+        let dir = Vec3::select(tiny, dir * 0.0, dir);
         Ray { origin, dir, inv_dir: dir.recip(), cull_backfaces: false }
     }
     /// The same ray, culling back faces or not.
