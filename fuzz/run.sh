@@ -4,8 +4,9 @@
 #
 #   fuzz/run.sh list                       the targets
 #   fuzz/run.sh build                      build every target
-#   fuzz/run.sh run TARGET [RUNS]          run TARGET for RUNS executions (default 10^7) or until a failure;
-#                                          prints libFuzzer's final stats; exit code non-zero on a failure
+#   fuzz/run.sh run TARGET [RUNS [FLAGS]]  run TARGET for RUNS executions (default 10^7) or until a failure;
+#                                          prints libFuzzer's final stats; exit code non-zero on a failure;
+#                                          FLAGS go to libFuzzer (e.g. -max_total_time=1800)
 #   fuzz/run.sh all [RUNS]                 every target in turn
 #   fuzz/run.sh replay TARGET FILE...      run TARGET on the given inputs only (crash files, corpora)
 #
@@ -28,6 +29,7 @@ FLAGS=(-a -s "$SAN")
 
 run_one() {
     local target=$1 runs=${2:-10000000}
+    shift 2 || shift $#
     mkdir -p "corpus/$target"
     echo "== $target: $runs executions (sanitizer $SAN)" >&2
     # `-jobs` makes libFuzzer write each job's output to fuzz-N.log instead of the terminal: only with >1.
@@ -35,13 +37,16 @@ run_one() {
     if [ "${FUZZ_JOBS:-1}" -gt 1 ]; then jobs=(-jobs="$FUZZ_JOBS" -workers="$FUZZ_JOBS"); fi
     cargo fuzz run "${FLAGS[@]}" "$target" "corpus/$target" "seeds/$target" -- \
         -runs="$runs" -rss_limit_mb=1024 -timeout=10 -max_len="${FUZZ_MAX_LEN:-8192}" \
-        "${jobs[@]}" -print_final_stats=1
+        "${jobs[@]}" -print_final_stats=1 "$@"
 }
 
 case "${1:-}" in
     list) cargo fuzz list ;;
     build) cargo fuzz build "${FLAGS[@]}" ;;
-    run) run_one "${2:?target}" "${3:-10000000}" ;;
+    run)
+        shift
+        run_one "${1:?target}" "${2:-10000000}" "${@:3}"
+        ;;
     all)
         for t in $(cargo fuzz list); do run_one "$t" "${2:-10000000}"; done
         ;;
