@@ -16,6 +16,13 @@
 //! - make-leaf ([`Builder::make_leaf`]): its primitives, in index order.
 //!
 //! Events carry `-0.0` folded into `+0.0`, so equal positions are equal bit patterns for sorting.
+//!
+//! Parallel: the two children of a node with at least [`PARALLEL_MIN`] primitives are built at once
+//! (`rayon::join`), the right one by a builder of its own (its own `side` scratch: a primitive straddling
+//! the plane is in both subtrees) whose nodes and references are then appended after the left subtree's,
+//! with their offsets moved. The flat tree is the one the sequential build writes, node for node.
+
+use rayon::prelude::*;
 
 use super::{split_box, KdTreeParams, Node};
 use crate::accel::Primitives;
@@ -51,6 +58,9 @@ struct Split {
     cost: f64,
 }
 
+/// Nodes with at least this many primitives build their two children in parallel.
+const PARALLEL_MIN: usize = 4096;
+
 /// True for bounds a primitive can be hit within: finite and not empty.
 pub(super) fn is_live(b: &Aabb) -> bool {
     !b.is_empty() && b.min.is_finite() && b.max.is_finite()
@@ -61,6 +71,16 @@ pub(super) fn build<P: Primitives + ?Sized>(
     prims: &P,
     params: &KdTreeParams,
     max_depth: usize,
+) -> (Vec<Node>, Vec<u32>, Aabb) {
+    build_split_at(prims, params, max_depth, PARALLEL_MIN)
+}
+
+/// [`build`], building children in parallel below nodes of `parallel_min` primitives or more.
+pub(super) fn build_split_at<P: Primitives + ?Sized>(
+    prims: &P,
+    params: &KdTreeParams,
+    max_depth: usize,
+    parallel_min: usize,
 ) -> (Vec<Node>, Vec<u32>, Aabb) {
     let mut events: Events = Default::default();
     let mut bounds = Aabb::EMPTY;
@@ -76,17 +96,9 @@ pub(super) fn build<P: Primitives + ?Sized>(
     if live == 0 {
         return (Vec::new(), Vec::new(), Aabb::EMPTY);
     }
-    for list in &mut events {
-        list.sort_unstable_by(order);
-    }
-    let mut builder = Builder {
-        prims,
-        params: *params,
-        max_depth,
-        side: vec![BOTH; prims.len()],
-        nodes: Vec::new(),
-        refs: Vec::new(),
-    };
+    // `order` is total (a primitive has one event of a kind per axis), so the parallel sort is deterministic.
+    events.par_iter_mut().for_each(|list| list.par_sort_unstable_by(order));
+    let mut builder = Builder::new(prims, params, max_depth, parallel_min);
     builder.build_node(events, &bounds, live, 0);
     (builder.nodes, builder.refs, bounds)
 }
@@ -187,13 +199,26 @@ struct Builder<'a, P: ?Sized> {
     prims: &'a P,
     params: KdTreeParams,
     max_depth: usize,
+    parallel_min: usize,
     /// Side of each primitive of the node being partitioned (scratch, indexed by primitive).
     side: Vec<u8>,
     nodes: Vec<Node>,
     refs: Vec<u32>,
 }
 
-impl<P: Primitives + ?Sized> Builder<'_, P> {
+impl<'a, P: Primitives + ?Sized> Builder<'a, P> {
+    fn new(prims: &'a P, params: &KdTreeParams, max_depth: usize, parallel_min: usize) -> Self {
+        Builder {
+            prims,
+            params: *params,
+            max_depth,
+            parallel_min,
+            side: vec![BOTH; prims.len()],
+            nodes: Vec::new(),
+            refs: Vec::new(),
+        }
+    }
+
     fn build_node(&mut self, events: Events, bx: &Aabb, n: usize, depth: usize) {
         let split = if depth < self.max_depth && n > 0 { find_split(&events, bx, n, &self.params) } else { None };
         let Some(split) = split else {
@@ -203,9 +228,26 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         let ((left, n_left), (right, n_right)) = self.partition(events, &split, &below, &above);
         let me = self.nodes.len();
         self.nodes.push(Node::leaf(0, 0));
-        self.build_node(left, &below, n_left, depth + 1);
+        if n < self.parallel_min {
+            self.build_node(left, &below, n_left, depth + 1);
+            self.nodes[me] = Node::inner(split.axis, split.pos, self.nodes.len() as u32);
+            self.build_node(right, &above, n_right, depth + 1);
+            return;
+        }
+        let mut other = Builder::new(self.prims, &self.params, self.max_depth, self.parallel_min);
+        rayon::join(
+            || self.build_node(left, &below, n_left, depth + 1),
+            || other.build_node(right, &above, n_right, depth + 1),
+        );
         self.nodes[me] = Node::inner(split.axis, split.pos, self.nodes.len() as u32);
-        self.build_node(right, &above, n_right, depth + 1);
+        self.append(other);
+    }
+
+    /// Appends a subtree built by another builder, moving its child and reference offsets.
+    fn append(&mut self, other: Builder<'_, P>) {
+        let (node_base, ref_base) = (self.nodes.len() as u32, self.refs.len() as u32);
+        self.nodes.extend(other.nodes.into_iter().map(|node| node.relocated(node_base, ref_base)));
+        self.refs.extend(other.refs);
     }
 
     /// A leaf over the primitives of `events` (one axis' list: each primitive has exactly one start or

@@ -97,6 +97,17 @@ impl Node {
     pub fn count(&self) -> usize {
         (self.flags >> 2) as usize
     }
+    /// The same node in a subtree moved to start at node `node_base` with its references at `ref_base`
+    /// (a subtree built apart, then appended).
+    pub(super) fn relocated(self, node_base: u32, ref_base: u32) -> Self {
+        if !self.is_leaf() {
+            Node::inner(self.axis(), self.split(), self.above() as u32 + node_base)
+        } else if self.count() >= 2 {
+            Node::leaf(self.count() as u32, self.data + ref_base)
+        } else {
+            self
+        }
+    }
     /// A leaf's primitives, resolved against the reference array.
     #[inline]
     pub fn prims<'a>(&'a self, refs: &'a [u32]) -> &'a [u32] {

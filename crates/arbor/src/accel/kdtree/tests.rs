@@ -285,3 +285,16 @@ fn kdtree_params_parse_and_depth_limit_holds() {
     tree.validate(&mesh).unwrap();
     assert!(Accel::<TriangleMesh>::stats(&tree).max_depth < MAX_DEPTH);
 }
+
+#[test]
+fn kdtree_parallel_build_writes_the_sequential_tree() {
+    let mesh = soup(3000, 91);
+    let params = KdTreeParams::default();
+    let sequential = build::build_split_at(&mesh, &params, 20, usize::MAX);
+    for parallel_min in [2, 64, 1000] {
+        let parallel = build::build_split_at(&mesh, &params, 20, parallel_min);
+        assert_eq!(parallel.0, sequential.0, "nodes, parallel below {parallel_min}");
+        assert_eq!(parallel.1, sequential.1, "references, parallel below {parallel_min}");
+    }
+    assert!(sequential.0.len() > 1000 && !sequential.1.is_empty());
+}
