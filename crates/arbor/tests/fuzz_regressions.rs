@@ -91,6 +91,12 @@ fn fuzz_triangle_hit_below_t_max_is_reported_at_t_max() {
 /// `Option`, primitive and `t` bits, same `occluded`), as `accel_differential` checks. Returns the
 /// failures, one line each.
 fn differential(verts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[([f32; 3], [f32; 3], f32)]) -> Vec<String> {
+    let rays: Vec<_> = rays.iter().map(|&(o, d, t_max)| (o, d, t_max, false)).collect();
+    differential_culled(verts, tris, &rays)
+}
+
+/// [`differential`] with a back-face culling flag per ray.
+fn differential_culled(verts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[([f32; 3], [f32; 3], f32, bool)]) -> Vec<String> {
     use arbor::accel::{build, AccelKind};
     use arbor::geometry::TriangleMesh;
     use arbor::math::{Ray, Vec3};
@@ -103,8 +109,8 @@ fn differential(verts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[([f32; 3], [f32; 
     let mut failures = Vec::new();
     for &kind in AccelKind::ALL {
         let accel = build(kind, &mesh);
-        for &(o, d, t_max) in rays {
-            let ray = Ray::new(Vec3::from(o), Vec3::from(d));
+        for &(o, d, t_max, cull) in rays {
+            let ray = Ray::new(Vec3::from(o), Vec3::from(d)).with_culling(cull);
             let (want, got) = (brute.intersect(&mesh, &ray, t_max), accel.intersect(&mesh, &ray, t_max));
             if want.map(|h| (h.prim, h.t.to_bits())) != got.map(|h| (h.prim, h.t.to_bits())) {
                 failures.push(format!("{kind}: {ray:?} t_max {t_max}: hit {got:?}, brute force {want:?}"));
@@ -179,5 +185,82 @@ fn fuzz_accel_subnormal_direction() {
     let tris = [[0, 1, 2], [2, 1, 3]];
     let rays = [([6.887942471542206e-41, -30.0, -30.0], [-6.887942471542206e-41, 30.0, 31.0], f32::INFINITY)];
     let failures = differential(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Found by `accel_differential` (2026-11-22, second session, after about 380,000 executions without
+/// the sanitizer; `fuzz/crashes/accel_differential/crash-8a04...`, cut to its failing ray): a ray along
+/// `(4.2e-15, -1.6e32, 31.25)`: brute force hits triangle 6 at `t = 0.9999999`, the kd-tree returned
+/// triangle 21 one ulp farther. And (`crash-7560...`, from a run stopped by hand) a ray along
+/// `(-4.1e31, 0, 1.08e-19)` that brute force hits at a vertex, which the SAH BVH missed.
+///
+/// Cause: the watertight test shears by `d[k] * (1 / d[major])`, which underflows for these rays
+/// (4.2e-15 / 1.6e32 and 1.08e-19 / 4.1e31 are far below `f32::MIN_POSITIVE`); it then traces a ray
+/// whose minor component is effectively zero, finds an edge function exactly zero and reports a hit on
+/// the edge that the true ray passes, which the structures' box and plane tests, made on the true ray,
+/// rule out. Fixed in `geometry/triangle.rs`: the double-precision fallback for a zero edge function
+/// now shears in double precision too, so it sees the true ray. The conformance suite's subnormal case
+/// found the same with the product `sx * a.z` underflowing (ratios just above `f32::MIN_POSITIVE`).
+#[test]
+fn fuzz_accel_direction_component_negligible_against_the_major_one() {
+    let verts = [
+        [-8.75, -24.75, -29.5],
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.2280755823866435e+30],
+        [0.0, 0.0, 0.0],
+        [4.174460002524154e-15, 1.5, 1.25],
+        [-0.25, -28.75, -29.5],
+    ];
+    let tris = [
+        [0, 5, 0],
+        [0, 0, 0],
+        [3, 3, 0],
+        [0, 0, 0],
+        [3, 2, 0],
+        [5, 4, 0],
+        [2, 1, 0],
+        [0, 2, 3],
+        [0, 1, 1],
+        [1, 3, 1],
+        [5, 1, 3],
+        [3, 3, 3],
+        [3, 3, 3],
+        [3, 3, 2],
+        [0, 1, 0],
+        [0, 1, 0],
+        [5, 2, 0],
+        [5, 0, 0],
+        [0, 0, 3],
+        [0, 0, 3],
+        [0, 5, 5],
+        [5, 2, 3],
+        [0, 5, 0],
+        [0, 0, 0],
+    ];
+    let rays = [(
+        [0.0, 1.616255289003517e+32, -30.0],
+        [4.174460002524154e-15, -1.616255289003517e+32, 31.25],
+        f32::INFINITY,
+        true,
+    )];
+    let failures = differential_culled(&verts, &tris, &rays);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+
+    let verts = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0842021724855044e-19],
+        [1.25, 0.0, 0.0],
+        [1.0, 0.0, -30.0],
+        [-29.75, 1.0, -30.0],
+        [-29.75, -29.5, -30.0],
+    ];
+    let tris = [[1, 2, 2], [1, 0, 0], [0, 1, 0], [4, 5, 1], [3, 4, 0], [3, 3, 3]];
+    let rays = [(
+        [4.1198301172484685e+31, 0.0, 0.0],
+        [-4.1198301172484685e+31, 0.0, 1.0842021724855044e-19],
+        f32::INFINITY,
+        true,
+    )];
+    let failures = differential_culled(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

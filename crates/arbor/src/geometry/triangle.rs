@@ -47,6 +47,7 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     let mut a = permute(p0 - ray.origin, kx, ky, kz);
     let mut b = permute(p1 - ray.origin, kx, ky, kz);
     let mut c = permute(p2 - ray.origin, kx, ky, kz);
+    let (a0, b0, c0) = (a, b, c);
 
     let sz = 1.0 / d.z;
     let sx = -d.x * sz;
@@ -62,9 +63,7 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     let mut e1 = c.x * a.y - c.y * a.x;
     let mut e2 = a.x * b.y - a.y * b.x;
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        e0 = (b.x as f64 * c.y as f64 - b.y as f64 * c.x as f64) as f32;
-        e1 = (c.x as f64 * a.y as f64 - c.y as f64 * a.x as f64) as f32;
-        e2 = (a.x as f64 * b.y as f64 - a.y as f64 * b.x as f64) as f32;
+        [e0, e1, e2] = edges_f64(d, [a0, b0, c0]);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
@@ -109,6 +108,29 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
         return None;
     }
     Some(TriHit { t, b1: e1 * inv_det, b2: e2 * inv_det })
+}
+
+/// The edge functions in double precision, sheared in double too, for when a single-precision one is
+/// exactly zero (Woop et al.'s fallback). Shearing again matters at tiny scales: a single-precision
+/// `sx * a.z` can underflow to zero and put a vertex exactly on a ray that passes it at 1e-79, which
+/// no box test of the true ray would reach (found by the conformance suite). A nonzero double value
+/// that underflows in single precision keeps its sign as the smallest subnormal. The shared edge of
+/// two triangles is computed from the same two vertices either way, so watertightness holds.
+#[cold]
+fn edges_f64(d: Vec3, [a, b, c]: [Vec3; 3]) -> [f32; 3] {
+    let sz = 1.0 / d.z as f64;
+    let (sx, sy) = (-d.x as f64 * sz, -d.y as f64 * sz);
+    let shear = |p: Vec3| (p.x as f64 + sx * p.z as f64, p.y as f64 + sy * p.z as f64);
+    let ((ax, ay), (bx, by), (cx, cy)) = (shear(a), shear(b), shear(c));
+    let single = |e: f64| {
+        let f = e as f32;
+        if f == 0.0 && e != 0.0 {
+            f32::from_bits(1).copysign(e.signum() as f32)
+        } else {
+            f
+        }
+    };
+    [single(bx * cy - by * cx), single(cx * ay - cy * ax), single(ax * by - ay * bx)]
 }
 
 #[cfg(test)]
@@ -171,5 +193,19 @@ mod tests {
         assert!(intersect_triangle(&nan, P0, P1, P2, f32::INFINITY).is_none());
         let in_plane = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0));
         assert!(intersect_triangle(&in_plane, P0, P1, P2, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn triangle_hit_at_subnormal_t_is_kept_just_above_it() {
+        // Scaled triangles so that `det` is not a power of two and `t_max * det` rounds as a subnormal.
+        for k in 1..200 {
+            let s = 0.3 + k as f32 * 0.037;
+            let (p0, p1, p2) = (P0 * s, P1 * s, P2 * (s * 1.3));
+            let ray = Ray::new(Vec3::new(0.01, 0.02, 1e-40 * k as f32), Vec3::new(0.0, 0.0, -1.0 - k as f32 * 0.01));
+            let hit = intersect_triangle(&ray, p0, p1, p2, f32::INFINITY).expect("hit with t_max infinite");
+            let above = f32::from_bits(hit.t.to_bits() + 1);
+            let again = intersect_triangle(&ray, p0, p1, p2, above).map(|h| h.t);
+            assert_eq!(again, Some(hit.t), "scale {s}: hit at t {:e}, none below t_max {above:e}", hit.t);
+        }
     }
 }
