@@ -7,9 +7,11 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod accum;
 pub mod bench;
 pub mod camera;
 pub mod error;
+pub mod farm;
 pub mod film;
 pub mod geometry;
 pub mod image_io;
