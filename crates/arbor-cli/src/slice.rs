@@ -57,7 +57,8 @@ impl Slice {
     ) -> Result<Option<Slice>, Failure> {
         let exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
         let flagged = a.tile.is_some() || a.sample_offset.is_some() || a.sample_count.is_some();
-        if !flagged && !(crop.is_some() && exr) {
+        let slice = flagged || (crop.is_some() && exr);
+        if !slice {
             return Ok(None);
         }
         if !exr {

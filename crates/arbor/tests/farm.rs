@@ -91,7 +91,7 @@ fn farm_merge_refuses_parts_that_do_not_fit() {
         format!("{}: samples 1..4 of pixel (0, 0) are also in {}", name(&b), name(&a))
     );
     assert_eq!(err(&[a.clone(), c]), "the parts do not cover pixel (0, 0): no part has its samples 2..3");
-    assert_eq!(err(&[a.clone()]), "the parts do not cover pixel (0, 0): no part has its samples 2..4");
+    assert_eq!(err(std::slice::from_ref(&a)), "the parts do not cover pixel (0, 0): no part has its samples 2..4");
 
     let mut other = part(&scene, d, None, (2, 4));
     other.1.identity = "another scene".into();

@@ -49,8 +49,7 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
         }
     }
     channels.push(AnyChannel::new("W", FlatSamples::U32(vec![count; s.sums.len()])));
-    let mut attrs = LayerAttributes::default();
-    attrs.layer_position = Vec2(x0 as i32, y0 as i32);
+    let mut attrs = LayerAttributes { layer_position: Vec2(x0 as i32, y0 as i32), ..Default::default() };
     let text = |v: &str| AttributeValue::Text(Text::new_or_none(v).unwrap_or_else(|| Text::from("?")));
     attrs.other.insert(Text::from("arbor.render"), text(&part.identity));
     attrs.other.insert(Text::from("arbor.camera"), text(&part.camera));
