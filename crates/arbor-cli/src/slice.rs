@@ -107,7 +107,8 @@ pub fn identity(scene: &[u8], camera: &str, spp: u32, cull: Option<bool>, env: O
     for &b in scene.iter().chain(options.as_bytes()) {
         h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
     }
-    format!("fnv1a64:{h:016x} camera={camera} spp={spp}")
+    // Escaped: EXR text attributes hold Latin-1 only, and the identity must survive the trip intact.
+    format!("fnv1a64:{h:016x} camera={} spp={spp}", camera.escape_default())
 }
 
 #[cfg(test)]
@@ -119,6 +120,26 @@ mod tests {
         assert_eq!(parse_tile("3/16"), Ok((3, 16)));
         assert_eq!(parse_tile("3"), Err("expected I/N (e.g. 3/16), got '3'".to_string()));
         assert_eq!(parse_tile("a/2"), Err("'a' is not a whole number".to_string()));
+    }
+
+    fn slice(offset: Option<u32>, count: Option<u32>) -> Slice {
+        Slice { out: PathBuf::from("p.exr"), tile: None, crop: None, offset, count }
+    }
+
+    #[test]
+    fn slice_sample_ranges_default_to_the_rest() {
+        assert!(matches!(slice(None, None).samples(8), Ok((0, 8))));
+        assert!(matches!(slice(Some(3), None).samples(8), Ok((3, 8))));
+        assert!(matches!(slice(None, Some(2)).samples(8), Ok((0, 2))));
+        assert!(matches!(slice(Some(6), Some(2)).samples(8), Ok((6, 8))));
+        for (k, n) in [(Some(8), None), (Some(7), Some(2)), (Some(u32::MAX), Some(u32::MAX))] {
+            assert!(matches!(slice(k, n).samples(8), Err(Failure::Usage(_))), "{k:?} {n:?}");
+        }
+    }
+
+    #[test]
+    fn slice_identity_is_ascii_for_any_camera_id() {
+        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, None, None).is_ascii());
     }
 
     #[test]
