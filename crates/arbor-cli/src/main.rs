@@ -1,4 +1,5 @@
-//! `arbor`: render scene files, describe them, benchmark their acceleration structures, compare images.
+//! `arbor`: render scene files (whole or in farm slices), merge slices, describe scenes, benchmark their
+//! acceleration structures, compare images.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
 //! 4 I/O failure, 130 and 143 when `render` was stopped by SIGINT or SIGTERM (no image written).
@@ -12,7 +13,10 @@ macro_rules! say {
 mod bench;
 mod diff;
 mod info;
+mod merge;
+mod progress;
 mod render;
+mod slice;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -37,6 +41,8 @@ enum Command {
     /// structure with build statistics, Mrays/s and speedup over brute force; checks every structure's
     /// hits against the default one's (any difference: exit 3).
     Bench(bench::BenchArgs),
+    /// Merge partial EXRs of render slices (tiles, sample ranges) into the full image.
+    Merge(merge::MergeArgs),
     /// Compare an image with a reference: PSNR and the share of pixels off by more than a threshold.
     Diff(diff::DiffArgs),
 }
@@ -45,6 +51,8 @@ enum Command {
 pub enum Failure {
     /// The comparison was above its threshold (exit 1).
     TooDifferent,
+    /// Options that do not make sense together (exit 2, like clap's own usage errors).
+    Usage(String),
     /// An error from the library (exit 3 for bad input, 4 for I/O).
     Arbor(arbor::Error),
     /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
@@ -91,10 +99,15 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
+        Command::Merge(args) => merge::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::TooDifferent) => ExitCode::from(1),
+        Err(Failure::Usage(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(2)
+        }
         Err(Failure::Interrupted(code)) => {
             eprintln!("interrupted: an image whose render was stopped is not written");
             ExitCode::from(code)

@@ -1,5 +1,7 @@
 //! `arbor render`: every camera of a scene to the image file it names, with a progress bar on a terminal
-//! and one summary line per image.
+//! (plain lines otherwise), one summary line and one `Saved: PATH` line per image, and optionally the
+//! same numbers as JSON (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs
+//! instead ([`crate::slice`]).
 //!
 //! SIGINT and SIGTERM stop the render between tiles: the image being rendered is not written (the
 //! previous file, if any, stays as it was; images are written whole, by rename), and the command exits
@@ -12,13 +14,16 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use arbor::accel::{AccelKind, AccelSpec};
+use arbor::farm::{write_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
-use arbor::render::{render, RenderOptions};
+use arbor::render::{render, render_sums, RenderOptions, RenderStats};
 use arbor::scene::{check_limits, load_desc, parse_desc, Scene, SceneDesc, SceneLimits};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
 
+use crate::progress::Progress;
+use crate::slice::{identity, Slice, SliceArgs};
 use crate::Failure;
 
 /// The scene rendered when none is named: the repository's own Cornell box.
@@ -30,7 +35,8 @@ const EXAMPLE: &str = include_str!("../../../examples/cornell_box.xml");
 pub struct RenderArgs {
     /// Scene file (.xml or .json). Without one, renders the built-in example Cornell box.
     pub scene: Option<PathBuf>,
-    /// Folder for the images (created if missing); each camera's file name comes from the scene.
+    /// Folder for the images (created if missing); each camera's file name comes from the scene. For a
+    /// slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR file.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
     /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.
@@ -67,7 +73,12 @@ pub struct RenderArgs {
     /// output is the window's size, and its pixels equal the same pixels of the full render.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
     pub crop: Option<(u32, u32, u32, u32)>,
-    /// No progress bar and no summary lines.
+    #[command(flatten)]
+    pub slice: SliceArgs,
+    /// Write the render's numbers (scene, camera, size, window, samples, times, rays) as JSON to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+    /// No progress bar and no summary lines (`Saved: PATH` lines stay).
     #[arg(short, long)]
     pub quiet: bool,
     /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
@@ -154,6 +165,7 @@ pub fn limits(no_limits: bool) -> SceneLimits {
 pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let signals = Signals::install()?;
     crate::set_threads(args.threads)?;
+    let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
     let parse_time = t0.elapsed();
@@ -181,21 +193,30 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     if cameras.is_empty() {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
     }
+    if slice.is_some() && cameras.len() != 1 {
+        return Err(Failure::Usage(format!(
+            "a slice renders one camera, but {} has {}: pick one with --camera ID",
+            crate::shown(&args.scene),
+            cameras.len()
+        )));
+    }
     check_limits(&desc, args.spp, &limits(args.no_limits))?;
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
     let spec = accel_spec(args.accel, &args.accel_params)?;
     let scene = Scene::build(desc, &spec, env)?;
-    let opts = RenderOptions {
+    let cull = if args.cull {
+        Some(true)
+    } else if args.no_cull {
+        Some(false)
+    } else {
+        None
+    };
+    let base = RenderOptions {
         spp: args.spp,
-        cull_backfaces: if args.cull {
-            Some(true)
-        } else if args.no_cull {
-            Some(false)
-        } else {
-            None
-        },
+        cull_backfaces: cull,
         debug: args.debug,
         crop: args.crop,
+        samples: None,
         cancel: Some(Arc::clone(&signals.cancel)),
     };
     if let Some((_, _, x1, y1)) = args.crop {
@@ -207,66 +228,119 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
             .into());
         }
     }
+    let mut records = Vec::new();
     for &c in &cameras {
         let cam = &scene.desc.cameras[c];
-        let path = args.out.join(&cam.image_name);
-        let bar = progress_bar(args.quiet, cam.width as u64 * cam.height as u64, &cam.image_name);
-        signals.check()?;
-        let (film, stats) = render(&scene, c, &opts, &|done, _| bar.set_position(done));
-        bar.finish_and_clear();
-        // A signal during the render leaves an incomplete film: never written.
-        signals.check()?;
-        arbor::image_io::write_image(&path, &film)?;
+        let spp = args.spp.unwrap_or(cam.num_samples).max(1);
+        let (path, stats, window) = match &slice {
+            Some(s) => {
+                let opts = RenderOptions { crop: s.window(cam)?, samples: Some(s.samples(spp)?), ..base.clone() };
+                let scene_bytes = match &args.scene {
+                    Some(p) => std::fs::read(p).map_err(|e| arbor::Error::io(p, e))?,
+                    None => EXAMPLE.as_bytes().to_vec(),
+                };
+                let id = identity(&scene_bytes, &cam.id, spp, cull, args.env.as_deref());
+                let bar = Progress::new(args.quiet, pixels(opts.crop, cam.width, cam.height), &cam.image_name);
+                signals.check()?;
+                let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total));
+                bar.finish();
+                signals.check()?;
+                let window = sums.window;
+                write_partial(&s.out, &Partial { identity: id, camera: cam.id.clone(), sums })?;
+                (s.out.clone(), stats, window)
+            }
+            None => {
+                let path = args.out.join(&cam.image_name);
+                let bar = Progress::new(args.quiet, pixels(base.crop, cam.width, cam.height), &cam.image_name);
+                signals.check()?;
+                let (film, stats) = render(&scene, c, &base, &|done, total| bar.set(done, total));
+                bar.finish();
+                // A signal during the render leaves an incomplete film: never written.
+                signals.check()?;
+                arbor::image_io::write_image(&path, &film)?;
+                (path, stats, arbor::render::crop_window(base.crop, cam.width, cam.height))
+            }
+        };
         if !args.quiet {
-            let g = &scene.geometry.counts;
-            say!(
-                "{}  {}x{}  {} spp  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
-                 render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
-                path.display(),
-                film.width,
-                film.height,
-                stats.spp,
-                (parse_time + g.mesh_load).as_secs_f64() * 1e3,
-                scene.build_time.as_secs_f64() * 1e3,
-                args.accel,
-                g.triangles,
-                g.spheres,
-                g.planes,
-                stats.time.as_secs_f64() * 1e3,
-                stats.rays as f64 / 1e6,
-                stats.mrays_per_s()
-            );
-            let s = scene.geometry.accel_stats();
-            say!(
-                "  structure {}: {} nodes, {} leaves, depth max {} mean {:.1}{}",
-                s.kind,
-                s.nodes,
-                s.leaves,
-                s.max_depth,
-                s.mean_depth,
-                args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
-            );
+            summary(&args, &scene, &path, window, &stats, parse_time);
         }
+        say!("Saved: {}", path.display());
         if let Some(max) = stats.heatmap_max {
             // Printed even with --quiet: without it the heatmap's colours have no scale.
             say!("heatmap maximum {max} (nodes visited + primitives tested) for {}", path.display());
         }
+        records.push(json!({
+            "scene": crate::shown(&args.scene),
+            "camera": cam.id,
+            "image": path.display().to_string(),
+            "width": cam.width,
+            "height": cam.height,
+            "window": [window.0, window.1, window.2, window.3],
+            "spp": stats.spp,
+            "samples": [stats.samples.0, stats.samples.1],
+            "accel": args.accel.to_string(),
+            "parse_ms": (parse_time + scene.geometry.counts.mesh_load).as_secs_f64() * 1e3,
+            "build_ms": scene.build_time.as_secs_f64() * 1e3,
+            "render_ms": stats.time.as_secs_f64() * 1e3,
+            "rays": stats.rays,
+            "mrays_per_s": stats.mrays_per_s(),
+            "threads": rayon::current_num_threads(),
+            "triangles": scene.geometry.counts.triangles,
+        }));
+    }
+    if let Some(file) = &args.stats_json {
+        let text = serde_json::to_string_pretty(&json!({ "images": records }))
+            .map_err(|e| arbor::Error::Invalid(format!("cannot encode the statistics: {e}")))?;
+        std::fs::write(file, text + "\n").map_err(|e| arbor::Error::io(file, e))?;
     }
     // A signal during the last write let that (atomic) write finish; the run still reports it.
     signals.check()
 }
 
-/// A bar on standard error, drawn only on a terminal (indicatif hides it otherwise).
-fn progress_bar(quiet: bool, len: u64, name: &str) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+/// Pixels in the window of a `w` x `h` frame.
+fn pixels(crop: Option<(u32, u32, u32, u32)>, w: u32, h: u32) -> u64 {
+    let (x0, y0, x1, y1) = arbor::render::crop_window(crop, w, h);
+    (x1 - x0) as u64 * (y1 - y0) as u64
+}
+
+/// The two summary lines of one image.
+fn summary(
+    args: &RenderArgs,
+    scene: &Scene,
+    path: &Path,
+    window: (u32, u32, u32, u32),
+    stats: &RenderStats,
+    parse_time: std::time::Duration,
+) {
+    let g = &scene.geometry.counts;
+    let samples = match stats.samples {
+        (0, k1) if k1 == stats.spp => format!("{} spp", stats.spp),
+        (k0, k1) => format!("samples {k0}..{k1} of {} spp", stats.spp),
+    };
+    say!(
+        "{}  {}x{}  {samples}  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
+         render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
+        path.display(),
+        window.2 - window.0,
+        window.3 - window.1,
+        (parse_time + g.mesh_load).as_secs_f64() * 1e3,
+        scene.build_time.as_secs_f64() * 1e3,
+        args.accel,
+        g.triangles,
+        g.spheres,
+        g.planes,
+        stats.time.as_secs_f64() * 1e3,
+        stats.rays as f64 / 1e6,
+        stats.mrays_per_s()
     );
-    bar.set_message(name.to_string());
-    bar
+    let s = scene.geometry.accel_stats();
+    say!(
+        "  structure {}: {} nodes, {} leaves, depth max {} mean {:.1}{}",
+        s.kind,
+        s.nodes,
+        s.leaves,
+        s.max_depth,
+        s.mean_depth,
+        args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
+    );
 }

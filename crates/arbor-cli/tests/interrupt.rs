@@ -78,6 +78,22 @@ fn interrupt_sigint_keeps_the_older_image() {
     assert_eq!(std::fs::read(&old).unwrap(), b"an older image");
 }
 
+#[test]
+fn interrupt_sigterm_during_a_tile_writes_no_partial() {
+    // Schedulers preempt tasks with SIGTERM: the slice must not leave a partial EXR to be merged.
+    let tmp = tempfile::tempdir().unwrap();
+    let child = Command::new(ARBOR)
+        .args(["render", "--quiet", "--spp", "2000", "--threads", "2", "--tile", "0/2", "-o"])
+        .arg(tmp.path().join("tile-0.exr"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let code = signal_and_wait(child, "TERM", Duration::from_millis(1500));
+    assert_eq!(code, Some(143));
+    assert!(entries(tmp.path()).is_empty(), "left behind: {:?}", entries(tmp.path()));
+}
+
 fn render_png(out: &Path, extra: &[&str]) -> (u32, u32, Vec<u8>) {
     let status =
         Command::new(ARBOR).args(["render", "--quiet", "--spp", "2", "-o"]).arg(out).args(extra).status().unwrap();

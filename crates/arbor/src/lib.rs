@@ -3,13 +3,17 @@
 //!
 //! Data flows one way: scene file -> [`scene::SceneDesc`] (format-neutral, with source positions) ->
 //! [`scene::Scene`] (world-space primitives + an acceleration structure) -> [`render`] (integrator per
-//! pixel, tiles over rayon) -> [`film::Film`] -> image file ([`image_io`]).
+//! pixel, tiles over rayon, exact sample sums in [`accum`]) -> [`film::Film`] -> image file ([`image_io`]).
+//! On a farm, [`farm`] cuts a frame into tiles and sample ranges written as partial EXRs and merges them
+//! back into the same bits.
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod accum;
 pub mod bench;
 pub mod camera;
 pub mod error;
+pub mod farm;
 pub mod film;
 pub mod geometry;
 pub mod image_io;

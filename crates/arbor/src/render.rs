@@ -3,6 +3,10 @@
 //!
 //! A crop ([`RenderOptions::crop`]) traces only the tiles of the full frame that overlap a window, with
 //! the full frame's pixel coordinates and random streams, so its pixels are those of the full render.
+//! A sample range ([`RenderOptions::samples`]) traces only samples `k0..k1` of the pixel's `spp`, each
+//! with the stratum and random stream it has in the full render. Samples are summed exactly
+//! ([`crate::accum`]), so sums of disjoint ranges add up to the full render's sum bit for bit;
+//! [`render_sums`] returns those sums for a partial image ([`crate::farm`]).
 //! A cancellation flag ([`RenderOptions::cancel`]) is checked before every tile: once set, the remaining
 //! tiles are skipped and the result is marked [`RenderStats::cancelled`] (it must not be written).
 //!
@@ -15,11 +19,11 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use crate::accum::SampleSum;
 use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
 use crate::integrator::{DebugIntegrator, DebugView, Whitted};
-use crate::math::Color;
 use crate::sampler::{pixel_offset, Rng};
 use crate::scene::Scene;
 
@@ -38,6 +42,8 @@ pub struct RenderOptions {
     /// clamped to the frame. Box overlays are drawn in full-frame coordinates; the heatmap is scaled by
     /// the crop's own maximum, and its legend shows where the crop covers the frame's bottom rows.
     pub crop: Option<(u32, u32, u32, u32)>,
+    /// Trace only samples `k0..k1` of each pixel's `spp` (clamped to them); the film holds their mean.
+    pub samples: Option<(u32, u32)>,
     /// Stop early when this becomes true (a signal handler sets it): no tile starts after that.
     pub cancel: Option<Arc<AtomicBool>>,
 }
@@ -49,8 +55,10 @@ pub struct RenderStats {
     pub rays: u64,
     /// Wall time.
     pub time: Duration,
-    /// Samples per pixel used.
+    /// Samples per pixel of the full image (the stratification).
     pub spp: u32,
+    /// The range of samples traced, `k0..k1` (all: `0..spp`).
+    pub samples: (u32, u32),
     /// The heatmap view's largest per-pixel cost (nodes visited plus primitives tested).
     pub heatmap_max: Option<u32>,
     /// The render was cancelled before it finished: the film is incomplete.
@@ -72,6 +80,83 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> (Film, RenderStats) {
+    let desc = &scene.desc.cameras[camera];
+    let (w, h) = (desc.width, desc.height);
+    let (traced, stats, scale) = trace(scene, camera, opts, progress);
+    let count = stats.samples.1 - stats.samples.0;
+    // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
+    let mut film = Film::new(w, h);
+    for ((x0, y0, tw), sums) in traced {
+        for (k, s) in sums.into_iter().enumerate() {
+            let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
+            film.pixels[y * w as usize + x] = s.value(scale, count);
+        }
+    }
+    let heatmap_max = match opts.debug {
+        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
+        Some(DebugView::Boxes { depth }) => {
+            overlay_boxes(&mut film, desc, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
+            None
+        }
+        _ => None,
+    };
+    let (cx0, cy0, cx1, cy1) = crop_window(opts.crop, w, h);
+    if (cx0, cy0, cx1, cy1) != (0, 0, w, h) {
+        film = cut(&film, cx0, cy0, cx1, cy1);
+    }
+    (film, RenderStats { heatmap_max, ..stats })
+}
+
+/// The exact sample sums of one render's window, for a partial image that `arbor merge` combines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSums {
+    /// The full frame's width and height.
+    pub frame: (u32, u32),
+    /// The window rendered, `(x0, y0, x1, y1)` in frame pixels, end exclusive.
+    pub window: (u32, u32, u32, u32),
+    /// Samples per pixel of the full image.
+    pub spp: u32,
+    /// The samples summed, `k0..k1`.
+    pub samples: (u32, u32),
+    /// The scene's radiance scale, applied when the sums become pixels.
+    pub scale: f32,
+    /// Row-major sums of the window's pixels.
+    pub sums: Vec<SampleSum>,
+}
+
+/// Like [`render`], but returns the exact per-pixel sums instead of a film. Debug views are not
+/// supported (they are not sums of samples): `opts.debug` is ignored.
+pub fn render_sums(
+    scene: &Scene,
+    camera: usize,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> (RenderSums, RenderStats) {
+    let opts = RenderOptions { debug: None, ..opts.clone() };
+    let desc = &scene.desc.cameras[camera];
+    let window = crop_window(opts.crop, desc.width, desc.height);
+    let (traced, stats, scale) = trace(scene, camera, &opts, progress);
+    let ww = (window.2 - window.0) as usize;
+    let mut sums = vec![SampleSum::default(); ww * (window.3 - window.1) as usize];
+    for ((x0, y0, tw), tile) in traced {
+        for (k, s) in tile.into_iter().enumerate() {
+            let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
+            sums[y * ww + x] = s;
+        }
+    }
+    let frame = (desc.width, desc.height);
+    (RenderSums { frame, window, spp: stats.spp, samples: stats.samples, scale, sums }, stats)
+}
+
+/// Per-tile sums over the crop window: `((x0, y0, tile width), sums)`, the stats and the radiance scale.
+type Traced = Vec<((u32, u32, u32), Vec<SampleSum>)>;
+
+fn trace(
+    scene: &Scene,
+    camera: usize,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> (Traced, RenderStats, f32) {
     let start = Instant::now();
     let desc = &scene.desc.cameras[camera];
     let cam = Camera::new(desc);
@@ -80,6 +165,10 @@ pub fn render(
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
     let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
     let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(desc.num_samples).max(1) };
+    let (k0, k1) = match opts.samples {
+        Some((k0, k1)) if debug.is_none() => (k0.min(spp - 1), k1.clamp(k0.min(spp - 1) + 1, spp)),
+        _ => (0, spp),
+    };
     let (w, h) = (cam.width, cam.height);
     let (cx0, cy0, cx1, cy1) = crop_window(opts.crop, w, h);
     // The full frame's tile grid, cut to the window: pixel values do not depend on it, only on (x, y, k).
@@ -93,7 +182,7 @@ pub fn render(
     let rays = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.desc.radiance_scale };
 
-    let rendered: Vec<((u32, u32, u32), Vec<Color>)> = tiles
+    let traced: Traced = tiles
         .par_iter()
         .filter(|_| !is_cancelled())
         .map(|&(x0, y0, x1, y1)| {
@@ -101,20 +190,20 @@ pub fn render(
             let mut count = 0u64;
             for y in y0..y1 {
                 for x in x0..x1 {
-                    let mut sum = Color::ZERO;
-                    for k in 0..spp {
+                    let mut sum = SampleSum::default();
+                    for k in k0..k1 {
                         let mut rng = Rng::for_sample(x, y, k);
                         let offset = pixel_offset(k, spp, &mut rng);
                         let ray = cam.ray(x, y, offset, rng.next_2d());
-                        sum += match &debug {
+                        sum.add_sample(match &debug {
                             Some(d) => {
                                 count += 1;
                                 d.li_camera(&ray)
                             }
                             None => integrator.li_camera(&ray, &mut rng, &mut count),
-                        };
+                        });
                     }
-                    pixels.push(sum * (scale / spp as f32));
+                    pixels.push(sum);
                 }
             }
             rays.fetch_add(count, Ordering::Relaxed);
@@ -123,29 +212,16 @@ pub fn render(
             ((x0, y0, x1 - x0), pixels)
         })
         .collect();
-
-    // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
-    let mut film = Film::new(w, h);
-    for ((x0, y0, tw), pixels) in rendered {
-        for (k, c) in pixels.into_iter().enumerate() {
-            let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
-            film.pixels[y * w as usize + x] = c;
-        }
-    }
-    let heatmap_max = match opts.debug {
-        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
-        Some(DebugView::Boxes { depth }) => {
-            overlay_boxes(&mut film, desc, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
-            None
-        }
-        _ => None,
-    };
-    if (cx0, cy0, cx1, cy1) != (0, 0, w, h) {
-        film = cut(&film, cx0, cy0, cx1, cy1);
-    }
     let cancelled = is_cancelled();
-    let stats = RenderStats { rays: rays.into_inner(), time: start.elapsed(), spp, heatmap_max, cancelled };
-    (film, stats)
+    let stats = RenderStats {
+        rays: rays.into_inner(),
+        time: start.elapsed(),
+        spp,
+        samples: (k0, k1),
+        heatmap_max: None,
+        cancelled,
+    };
+    (traced, stats, scale)
 }
 
 /// The crop window clamped to a `w` x `h` frame, as `(x0, y0, x1, y1)` with `x0 < x1`, `y0 < y1` unless the

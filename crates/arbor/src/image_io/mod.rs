@@ -12,7 +12,7 @@
 
 pub mod metrics;
 mod read;
-mod write;
+pub(crate) mod write;
 
 pub use metrics::{compare_files, compare_rgb8, diff_image, Comparison};
 pub use read::{read_image, read_rgb8};

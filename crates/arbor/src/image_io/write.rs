@@ -89,7 +89,7 @@ fn encode(film: &Film, format: Format) -> image::ImageResult<Vec<u8>> {
 }
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),

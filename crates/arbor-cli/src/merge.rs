@@ -1,0 +1,48 @@
+//! `arbor merge PARTS... -o IMAGE`: partial EXRs of `arbor render` slices (tiles, sample ranges) into the
+//! full image, equal byte for byte to a single-process render. The rules and messages are the library's
+//! (`arbor::farm::merge`); parts that do not fit exit 3 naming the file.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::Failure;
+
+/// Arguments of `arbor merge`.
+#[derive(Args)]
+pub struct MergeArgs {
+    /// Partial EXR files written by `arbor render --tile/--sample-offset/--sample-count` (any order).
+    #[arg(required = true, value_name = "PARTS")]
+    pub parts: Vec<PathBuf>,
+    /// The merged image; the extension picks the format (.png, .ppm, .exr).
+    #[arg(short = 'o', long = "out", value_name = "IMAGE")]
+    pub out: PathBuf,
+    /// No summary line (`Saved: IMAGE` stays).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `arbor merge`.
+pub fn run(args: MergeArgs) -> Result<(), Failure> {
+    let start = std::time::Instant::now();
+    let parts = args
+        .parts
+        .iter()
+        .map(|p| arbor::farm::read_partial(p).map(|part| (p.clone(), part)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let film = arbor::farm::merge(&parts)?;
+    arbor::image_io::write_image(&args.out, &film)?;
+    if !args.quiet {
+        let spp = parts.first().map_or(0, |(_, p)| p.sums.spp);
+        say!(
+            "{}  {}x{}  {spp} spp  merged {} parts in {:.1} ms",
+            args.out.display(),
+            film.width,
+            film.height,
+            parts.len(),
+            start.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    say!("Saved: {}", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,80 @@
+//! Merging partial images: tiles side by side, sample ranges added, into the image a single process
+//! would have rendered, bit for bit.
+//!
+//! Rules, each refused with a message naming the file: every part has the identity, frame, samples per
+//! pixel and radiance scale of the first; no pixel gets the same sample twice (overlapping tiles or
+//! sample ranges); and every pixel gets every sample `0..spp` (no missing tile, no gap between ranges).
+//!
+//! Algorithm: parts are visited by sample start; a per-pixel counter holds the next sample expected, so a
+//! part starting below it overlaps an earlier part and one starting above it leaves a gap no later part
+//! can fill. Sums are exact integers, so the order of addition does not change the result. Cost: one
+//! pass over every part's pixels, two `u32` per frame pixel.
+
+use std::path::PathBuf;
+
+use crate::accum::SampleSum;
+use crate::error::{Error, Location, Result};
+use crate::farm::Partial;
+use crate::film::Film;
+
+/// Merges `parts` (each with the file it came from, for messages) into the full frame.
+pub fn merge(parts: &[(PathBuf, Partial)]) -> Result<Film> {
+    let Some((first_path, first)) = parts.first() else {
+        return Err(Error::Invalid("nothing to merge: no partial images given".into()));
+    };
+    let f = &first.sums;
+    for (path, p) in &parts[1..] {
+        let s = &p.sums;
+        let differs = if p.identity != first.identity {
+            Some("scene, camera or options")
+        } else if s.frame != f.frame {
+            Some("frame size")
+        } else if s.spp != f.spp {
+            Some("samples per pixel")
+        } else if s.scale.to_bits() != f.scale.to_bits() {
+            Some("radiance scale")
+        } else {
+            None
+        };
+        if let Some(what) = differs {
+            let msg = format!("not from the same render as {} (the {what} differ)", first_path.display());
+            return Err(Error::input(Location::file(path), msg));
+        }
+    }
+    let (w, h) = f.frame;
+    let mut next = vec![0u32; w as usize * h as usize];
+    let mut by = vec![u32::MAX; next.len()];
+    let mut total = vec![SampleSum::default(); next.len()];
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by_key(|&i| (parts[i].1.sums.samples.0, parts[i].1.sums.window.1, parts[i].1.sums.window.0));
+    for i in order {
+        let (path, p) = &parts[i];
+        let s = &p.sums;
+        let (x0, y0, x1, _) = s.window;
+        let (k0, k1) = s.samples;
+        for (j, sum) in s.sums.iter().enumerate() {
+            let (x, y) = (x0 + j as u32 % (x1 - x0), y0 + j as u32 / (x1 - x0));
+            let at = (y * w + x) as usize;
+            if next[at] > k0 {
+                let other = &parts[by[at] as usize].0;
+                let msg = format!("samples {k0}..{k1} of pixel ({x}, {y}) are also in {}", other.display());
+                return Err(Error::input(Location::file(path), msg));
+            }
+            if next[at] < k0 {
+                return Err(missing(x, y, next[at], k0));
+            }
+            next[at] = k1;
+            by[at] = i as u32;
+            total[at].add(sum);
+        }
+    }
+    if let Some(at) = next.iter().position(|&k| k != f.spp) {
+        return Err(missing(at as u32 % w, at as u32 / w, next[at], f.spp));
+    }
+    let pixels = total.iter().map(|s| s.value(f.scale, f.spp)).collect();
+    Ok(Film { width: w, height: h, pixels })
+}
+
+fn missing(x: u32, y: u32, from: u32, to: u32) -> Error {
+    Error::Invalid(format!("the parts do not cover pixel ({x}, {y}): no part has its samples {from}..{to}"))
+}

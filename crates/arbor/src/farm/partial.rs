@@ -1,0 +1,136 @@
+//! A slice's result on disk: an OpenEXR file that any EXR viewer opens, carrying what `arbor merge`
+//! needs to rebuild the exact single-process image.
+//!
+//! - Display window: the full frame (`0,0 .. width,height`); data window: the slice's pixels.
+//! - Channels `R`, `G`, `B` (float): the slice's own mean (for looking at it); `W` (uint): the samples
+//!   per pixel this file holds (its weight); `sumR0..sumR3`, `sumG0..`, `sumB0..` (uint): each channel's
+//!   exact fixed-point sample sum ([`crate::accum`]), an `i128` as four little-endian 32-bit limbs.
+//! - Header attributes: `arbor.render` (identity of the render: scene, camera and the options that
+//!   change pixels), `arbor.camera`, `arbor.spp` (samples per pixel of the full image),
+//!   `arbor.sampleStart` and `arbor.sampleEnd` (the samples held, `start..end`), `arbor.scale` (radiance
+//!   scale applied at the end).
+//!
+//! Written atomically like every image; read back with every field checked, errors naming the file.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use exr::prelude::*;
+
+use crate::accum::SampleSum;
+use crate::error::{Error, Location, Result};
+use crate::render::RenderSums;
+
+/// A partial image: the sums of one slice and where they belong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Partial {
+    /// The render's identity: partials merge only with partials of the same identity.
+    pub identity: String,
+    /// The camera's id (informative; part of the identity).
+    pub camera: String,
+    /// Frame, window, sample range, scale and the sums.
+    pub sums: RenderSums,
+}
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// Writes `part` to `path` (atomically: a temporary file renamed over the target).
+pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
+    let s = &part.sums;
+    let (x0, y0, x1, y1) = s.window;
+    let count = s.samples.1 - s.samples.0;
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+    for (c, name) in CHANNELS.iter().enumerate() {
+        let mean = s.sums.iter().map(|p| p.value(s.scale, count).to_array()[c]).collect();
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(mean)));
+        for limb in 0..4 {
+            let bits = s.sums.iter().map(|p| (p.0[c] as u128 >> (32 * limb)) as u32).collect();
+            channels.push(AnyChannel::new(format!("sum{name}{limb}").as_str(), FlatSamples::U32(bits)));
+        }
+    }
+    channels.push(AnyChannel::new("W", FlatSamples::U32(vec![count; s.sums.len()])));
+    let mut attrs = LayerAttributes { layer_position: Vec2(x0 as i32, y0 as i32), ..Default::default() };
+    let text = |v: &str| AttributeValue::Text(Text::new_or_none(v).unwrap_or_else(|| Text::from("?")));
+    attrs.other.insert(Text::from("arbor.render"), text(&part.identity));
+    attrs.other.insert(Text::from("arbor.camera"), text(&part.camera));
+    attrs.other.insert(Text::from("arbor.spp"), AttributeValue::I32(s.spp as i32));
+    attrs.other.insert(Text::from("arbor.sampleStart"), AttributeValue::I32(s.samples.0 as i32));
+    attrs.other.insert(Text::from("arbor.sampleEnd"), AttributeValue::I32(s.samples.1 as i32));
+    attrs.other.insert(Text::from("arbor.scale"), AttributeValue::F32(s.scale));
+    let size = ((x1 - x0) as usize, (y1 - y0) as usize);
+    let layer = Layer::new(size, attrs, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
+    let mut image = Image::from_layer(layer);
+    image.attributes.display_window = IntegerBounds::new((0, 0), (s.frame.0 as usize, s.frame.1 as usize));
+    let mut bytes = Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
+    crate::image_io::write::write_atomic(path, &bytes.into_inner())
+}
+
+/// Reads a partial image written by [`write_partial`].
+pub fn read_partial(path: &Path) -> Result<Partial> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bad = |msg: String| Error::input(Location::file(path), msg);
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
+    let layer = &image.layer_data;
+    let a = &layer.attributes.other;
+    let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());
+    let text = |k: &str| match a.get(&Text::from(k)) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+    let int = |k: &str| match a.get(&Text::from(k)) {
+        Some(AttributeValue::I32(v)) if *v >= 0 => Ok(*v as u32),
+        _ => Err(bad(format!("attribute {k} is missing or not a non-negative integer"))),
+    };
+    let identity = text("arbor.render").ok_or_else(not_partial)?;
+    let camera = text("arbor.camera").unwrap_or_default();
+    let (spp, k0, k1) = (int("arbor.spp")?, int("arbor.sampleStart")?, int("arbor.sampleEnd")?);
+    if !(k0 < k1 && k1 <= spp) {
+        return Err(bad(format!("sample range {k0}..{k1} is not inside 0..{spp}")));
+    }
+    let scale = match a.get(&Text::from("arbor.scale")) {
+        Some(AttributeValue::F32(v)) => *v,
+        _ => return Err(bad("attribute arbor.scale is missing or not a float".into())),
+    };
+    let dw = image.attributes.display_window;
+    let (pos, size) = (layer.attributes.layer_position, layer.size);
+    let frame = (dw.size.0 as u32, dw.size.1 as u32);
+    let (x0, y0) = (pos.0.max(0) as u32, pos.1.max(0) as u32);
+    let window = (x0, y0, x0 + size.0 as u32, y0 + size.1 as u32);
+    if dw.position != Vec2(0, 0) || pos.0 < 0 || pos.1 < 0 || window.2 > frame.0 || window.3 > frame.1 {
+        return Err(bad(format!(
+            "data window {:?}+{:?} is not inside the display window {:?}+{:?}",
+            pos, size, dw.position, dw.size
+        )));
+    }
+    let n = size.0 * size.1;
+    let channel = |name: &str| -> Result<&[u32]> {
+        match layer.channel_data.list.iter().find(|c| c.name.to_string() == name).map(|c| &c.sample_data) {
+            Some(FlatSamples::U32(v)) if v.len() == n => Ok(v),
+            _ => Err(bad(format!("channel {name} is missing or not {n} unsigned integers"))),
+        }
+    };
+    if let Some(i) = channel("W")?.iter().position(|&w| w != k1 - k0) {
+        return Err(bad(format!("weight W of pixel {i} of the window is not {} (samples {k0}..{k1})", k1 - k0)));
+    }
+    let mut sums = vec![SampleSum::default(); n];
+    for (c, name) in CHANNELS.iter().enumerate() {
+        for limb in 0..4 {
+            for (s, &bits) in sums.iter_mut().zip(channel(&format!("sum{name}{limb}"))?) {
+                s.0[c] = (s.0[c] as u128 | (bits as u128) << (32 * limb)) as i128;
+            }
+        }
+    }
+    let sums = RenderSums { frame, window, spp, samples: (k0, k1), scale, sums };
+    Ok(Partial { identity, camera, sums })
+}

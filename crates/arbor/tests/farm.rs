@@ -1,0 +1,110 @@
+//! Farm slices merge back into the single-process image bit for bit: tiles of a fixed grid (4 and 9),
+//! sample ranges (4 = 1+3 = 2+2 = 1+1+1+1), both at once, through partial EXR files on disk; and the
+//! merge refuses parts that do not fit together, with messages naming the file.
+
+use std::path::{Path, PathBuf};
+
+use arbor::accel::{AccelKind, AccelSpec};
+use arbor::farm::{merge, read_partial, tile_window, write_partial, Partial};
+use arbor::film::Film;
+use arbor::render::{render, render_sums, RenderOptions};
+use arbor::scene::{parse_desc, Scene};
+
+fn example() -> Scene {
+    let text = include_str!("../../../examples/cornell_box.xml");
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/cornell_box.xml"));
+    let mut desc = parse_desc(text, path).unwrap_or_else(|e| panic!("{e}"));
+    for c in &mut desc.cameras {
+        (c.width, c.height) = (c.width / 8, c.height / 8 + 3);
+    }
+    assert_eq!(desc.cameras[0].num_samples, 4);
+    Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap()
+}
+
+fn bits(film: &Film) -> Vec<u32> {
+    film.pixels.iter().flat_map(|c| c.to_array()).map(f32::to_bits).collect()
+}
+
+/// Renders the slice, writes it as a partial EXR in `dir`, reads it back.
+fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)) -> (PathBuf, Partial) {
+    let cam = &scene.desc.cameras[0];
+    let crop = tile.map(|(i, n)| tile_window(i, n, cam.width, cam.height).unwrap());
+    let opts = RenderOptions { crop, samples: Some(samples), ..Default::default() };
+    let (sums, stats) = render_sums(scene, 0, &opts, &|_, _| {});
+    assert_eq!(stats.samples, samples);
+    let name = format!("part-{:?}-{}-{}.exr", tile.unwrap_or((0, 1)), samples.0, samples.1);
+    let path = dir.join(name);
+    let p = Partial { identity: "example".into(), camera: cam.id.clone(), sums };
+    write_partial(&path, &p).unwrap();
+    let back = read_partial(&path).unwrap();
+    assert_eq!(back, p, "{}", path.display());
+    (path, back)
+}
+
+#[test]
+fn farm_tiles_and_sample_ranges_merge_to_the_whole() {
+    let scene = example();
+    let dir = tempfile::tempdir().unwrap();
+    let whole = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).0;
+    let splits: [&[(u32, u32)]; 4] =
+        [&[(0, 4)], &[(0, 1), (1, 4)], &[(2, 4), (0, 2)], &[(3, 4), (0, 1), (2, 3), (1, 2)]];
+    for n in [1, 4, 9] {
+        for ranges in splits {
+            let parts: Vec<_> = (0..n)
+                .flat_map(|i| ranges.iter().map(move |&r| (i, r)))
+                .map(|(i, r)| part(&scene, dir.path(), Some((i, n)), r))
+                .collect();
+            let merged = merge(&parts).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(bits(&merged), bits(&whole), "{n} tiles, samples {ranges:?}");
+            assert_eq!(merged.to_rgb8(), whole.to_rgb8());
+        }
+    }
+}
+
+#[test]
+fn farm_merge_refuses_parts_that_do_not_fit() {
+    let scene = example();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let name = |p: &(PathBuf, Partial)| p.0.display().to_string();
+    let err = |parts: &[(PathBuf, Partial)]| merge(parts).map(|_| ()).unwrap_err().to_string();
+
+    let t: Vec<_> = (0..4).map(|i| part(&scene, d, Some((i, 4)), (0, 4))).collect();
+    assert_eq!(
+        err(&t[..3]),
+        format!(
+            "the parts do not cover pixel ({}, {}): no part has its samples 0..4",
+            t[3].1.sums.window.0, t[3].1.sums.window.1
+        )
+    );
+    let mut twice = t.clone();
+    twice.push(t[2].clone());
+    let (x, y) = (t[2].1.sums.window.0, t[2].1.sums.window.1);
+    let msg = format!("{}: samples 0..4 of pixel ({x}, {y}) are also in {}", name(&t[2]), name(&t[2]));
+    assert_eq!(err(&twice), msg);
+
+    let a = part(&scene, d, None, (0, 2));
+    let b = part(&scene, d, None, (1, 4));
+    let c = part(&scene, d, None, (3, 4));
+    assert_eq!(
+        err(&[a.clone(), b.clone()]),
+        format!("{}: samples 1..4 of pixel (0, 0) are also in {}", name(&b), name(&a))
+    );
+    assert_eq!(err(&[a.clone(), c]), "the parts do not cover pixel (0, 0): no part has its samples 2..3");
+    assert_eq!(err(std::slice::from_ref(&a)), "the parts do not cover pixel (0, 0): no part has its samples 2..4");
+
+    let mut other = part(&scene, d, None, (2, 4));
+    other.1.identity = "another scene".into();
+    let msg =
+        format!("{}: not from the same render as {} (the scene, camera or options differ)", name(&other), name(&a));
+    assert_eq!(err(&[a, other]), msg);
+}
+
+#[test]
+fn farm_read_partial_refuses_a_plain_exr() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plain.exr");
+    arbor::image_io::write_image(&path, &Film::new(3, 2)).unwrap();
+    let e = read_partial(&path).unwrap_err().to_string();
+    assert_eq!(e, format!("{}: not a partial image of `arbor render` (no arbor.render attribute)", path.display()));
+}
