@@ -10,6 +10,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bench_rays;
 mod diff;
 mod info;
 mod render;
