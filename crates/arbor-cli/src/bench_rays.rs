@@ -8,6 +8,10 @@
 //! One thread traces on the calling thread; more threads trace 1024-ray chunks on the rayon pool.
 //! `mismatch` is the share of rays whose hit disagrees with the reference peer's (hit or miss, or `t`
 //! off by more than 1e-4 relative, see [`disagrees`]).
+//!
+//! Each line also gives `cpu_build_ms` and `cpu_mrays`, the same medians in process CPU time
+//! (`getrusage`): on a machine shared with other jobs, wall time counts the time the scheduler gave
+//! to others, CPU time does not. Ratios to the peers use wall time, as the peers report only that.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -50,23 +54,26 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
     for spec in kinds {
         drop(build_with(spec, &warm_up).map_err(arbor::Error::Invalid)?);
         let mut builds = Vec::new();
+        let mut cpu_builds = Vec::new();
         let mut accel = None;
         for _ in 0..args.runs {
             drop(accel.take());
-            let start = Instant::now();
+            let (start, cpu) = (Instant::now(), cpu_time());
             let built = build_with(spec, &mesh).map_err(arbor::Error::Invalid)?;
             builds.push(start.elapsed().as_secs_f64() * 1e3);
+            cpu_builds.push((cpu_time() - cpu).as_secs_f64() * 1e3);
             accel = Some(built);
         }
         let Some(accel) = accel else { continue };
         let build_ms = median(&mut builds);
+        let cpu_build_ms = median(&mut cpu_builds);
         let list: Vec<String> = builds.iter().map(|b| format!("{b:.1}")).collect();
         say!("# peer=arbor-{} built in {} ms", spec.kind, list.join(", "));
         for set in &sets {
             let r = measure(accel.as_ref(), &mesh, set, threads);
             say!(
                 "peer=arbor-{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} tris={} \
-                 rays={} runs={} vs=reference mismatch={:.6}",
+                 rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} cpu_mrays={:.3}",
                 spec.kind,
                 set.name,
                 r.mrays,
@@ -75,7 +82,8 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
                 mesh.len(),
                 set.rays.len(),
                 r.runs,
-                r.mismatch
+                r.mismatch,
+                r.cpu_mrays
             );
         }
     }
@@ -84,6 +92,7 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
 
 struct Measured {
     mrays: f64,
+    cpu_mrays: f64,
     hits: usize,
     runs: usize,
     mismatch: f64,
@@ -91,17 +100,19 @@ struct Measured {
 
 fn measure(accel: &dyn Accel<TriangleMesh>, mesh: &TriangleMesh, set: &RaySetFile, threads: usize) -> Measured {
     let trace = |out: &mut Vec<Option<f32>>| {
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), cpu_time());
         trace_all(accel, mesh, &set.rays, threads, out);
-        start.elapsed()
+        (start.elapsed(), cpu_time() - cpu)
     };
     let mut ts = vec![None; set.rays.len()];
     let mut times = Vec::new();
+    let mut cpu_times = Vec::new();
     let mut total = Duration::ZERO;
     while times.len() < MIN_RUNS || total < MIN_TIME {
-        let dt = trace(&mut ts);
+        let (dt, cpu) = trace(&mut ts);
         total += dt;
         times.push(dt.as_secs_f64());
+        cpu_times.push(cpu.as_secs_f64());
         if total > MAX_TIME {
             break;
         }
@@ -110,6 +121,7 @@ fn measure(accel: &dyn Accel<TriangleMesh>, mesh: &TriangleMesh, set: &RaySetFil
     let wrong = ts.iter().zip(&set.hits).filter(|(t, r)| disagrees(**t, r)).count();
     Measured {
         mrays: set.rays.len() as f64 / secs / 1e6,
+        cpu_mrays: set.rays.len() as f64 / median(&mut cpu_times).max(1e-9) / 1e6,
         hits: ts.iter().flatten().count(),
         runs: times.len(),
         mismatch: wrong as f64 / set.rays.len().max(1) as f64,
@@ -141,4 +153,15 @@ fn trace_all(
 fn median(xs: &mut [f64]) -> f64 {
     xs.sort_by(f64::total_cmp);
     xs.get(xs.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// CPU time of the whole process so far (user and system, every thread).
+fn cpu_time() -> Duration {
+    // SAFETY: `getrusage` only writes the struct it is given, which is plain old data.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return Duration::ZERO;
+    }
+    let tv = |t: libc::timeval| Duration::new(t.tv_sec.max(0) as u64, (t.tv_usec.max(0) as u32) * 1000);
+    tv(u.ru_utime) + tv(u.ru_stime)
 }
