@@ -140,6 +140,26 @@ fn bytemuck_free_view(node: &Node4) -> &[f32; 32] {
     unsafe { &*(node as *const Node4).cast::<[f32; 32]>() }
 }
 
+/// Asks the cache for the node `r` refers to (its box lanes span the node's first 96 bytes), so that a
+/// child pushed now is in cache when popped: node fetches are most of a query's stalls.
+#[inline(always)]
+fn prefetch(wide: &Wide, r: Ref) {
+    #[cfg(target_arch = "x86_64")]
+    if r.count == 0 {
+        if let Some(node) = wide.nodes.get(r.child as usize) {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let p = (node as *const Node4).cast::<i8>();
+            // SAFETY: a prefetch never faults; both addresses are inside the node.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.add(64));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (wide, r);
+}
+
 /// True when no query can hit anything: invalid ray or an empty `(0, t_max)`.
 #[inline]
 fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
@@ -181,28 +201,29 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
                     cur = Ref { child: node.child[first], count: node.count[first] };
                     continue;
                 }
-                // Two to four children: sort by entry distance, push all but the nearest, farthest first.
-                let mut order = [Entry { r: Ref { child: 0, count: 0 }, near: 0.0, slack: 0.0 }; 4];
-                let mut n = 0;
+                // Two to four children: push them all, sort the pushed entries so that the nearest is on
+                // top (farthest deepest), and continue with the nearest.
+                let base = sp;
                 let mut m = mask;
                 while m != 0 {
                     let l = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let e =
                         Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
-                    let mut j = n;
-                    while j > 0 && order[j - 1].near > e.near {
-                        order[j] = order[j - 1];
+                    // Insertion by decreasing `near`: at most three moves.
+                    let mut j = sp;
+                    // SAFETY: `base..sp` were written in this loop.
+                    while j > base && unsafe { stack[j - 1].assume_init_ref() }.near < e.near {
+                        stack[j] = stack[j - 1];
                         j -= 1;
                     }
-                    order[j] = e;
-                    n += 1;
-                }
-                for e in order[1..n].iter().rev() {
-                    stack[sp] = MaybeUninit::new(*e);
+                    stack[j] = MaybeUninit::new(e);
                     sp += 1;
+                    prefetch(wide, e.r);
                 }
-                cur = order[0].r;
+                sp -= 1;
+                // SAFETY: written just above.
+                cur = unsafe { stack[sp].assume_init() }.r;
                 continue;
             }
         } else {
