@@ -13,9 +13,10 @@
 //! nodes build their halves with `rayon::join`; since each half owns a disjoint slice of the primitive
 //! array and every decision depends only on that slice, the result is identical for any thread count.
 //!
-//! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices and areas
-//! are computed in double precision, so centroids spanning the whole float range neither overflow nor
-//! produce NaN bins.
+//! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices are computed
+//! in single precision when the centroid extent and the bin scale are finite in it, else in double
+//! precision, so centroids spanning the whole float range neither overflow nor produce NaN bins; areas
+//! are always double precision.
 
 use rayon::prelude::*;
 
@@ -58,15 +59,37 @@ struct Binner {
     axis: usize,
     min: f64,
     scale: f64,
+    /// The same map in single precision, used when the extent and the scale are finite in it (always,
+    /// but for centroids spanning most of the float range): cheaper per primitive.
+    min32: f32,
+    scale32: f32,
+    single: bool,
     bins: usize,
 }
 
 impl Binner {
+    fn new(axis: usize, min: f32, max: f32, bins: usize) -> Binner {
+        let scale32 = bins as f32 / (max - min);
+        Binner {
+            axis,
+            min: min as f64,
+            scale: bins as f64 / (max as f64 - min as f64),
+            min32: min,
+            scale32,
+            single: (max - min).is_finite() && scale32.is_finite() && scale32 > 0.0,
+            bins,
+        }
+    }
+
     #[inline]
     fn bin(&self, c: Vec3) -> usize {
         // The minimum centroid lands in bin 0 and the maximum in the last bin (the ratio rounds to
         // `bins` or just below), so every candidate plane has primitives on both sides.
-        let k = ((c[self.axis] as f64 - self.min) * self.scale) as usize;
+        let k = if self.single {
+            ((c[self.axis] - self.min32) * self.scale32) as usize
+        } else {
+            ((c[self.axis] as f64 - self.min) * self.scale) as usize
+        };
         k.min(self.bins - 1)
     }
 }
@@ -154,12 +177,7 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
     if depth >= MAX_SAH_DEPTH {
         return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
     }
-    let binner = Binner {
-        axis,
-        min: cb.min[axis] as f64,
-        scale: params.bins as f64 / (cb.max[axis] as f64 - cb.min[axis] as f64),
-        bins: params.bins,
-    };
+    let binner = Binner::new(axis, cb.min[axis], cb.max[axis], params.bins);
     let (bin, cost) = best_bin(prims, bounds, &binner, params);
     if !cost.is_finite() {
         // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
