@@ -72,8 +72,9 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     intersect_triangle_in(&RayFrame::new(ray), p0, p1, p2, t_max)
 }
 
-/// [`intersect_triangle`] for a ray whose [`RayFrame`] is already known.
-#[inline]
+/// [`intersect_triangle`] for a ray whose [`RayFrame`] is already known (always inlined: it is the
+/// body of every structure's leaf loop).
+#[inline(always)]
 pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriHit> {
     if f.cull_backfaces && f.dir.dot((p1 - p0).cross(p2 - p0)) >= 0.0 {
         return None;
