@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use super::{BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
 use crate::accel::Primitives;
 use crate::math::{Aabb, Vec3};
+use glam::Vec3A;
 
 /// Nodes with at least this many primitives build their two children in parallel.
 pub(super) const PARALLEL_THRESHOLD: usize = 4096;
@@ -94,6 +95,37 @@ impl Binner {
     }
 }
 
+/// A box being grown, in SIMD lanes (glam's `Vec3A`: one `minps`/`maxps` per union on x86_64, where
+/// `Aabb`'s `f32::min`/`max` take three NaN-aware instructions per axis). The builder's boxes are all
+/// finite, so the results are exactly `Aabb::union`'s; this is most of the build's arithmetic.
+#[derive(Debug, Clone, Copy)]
+struct BoxAcc {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl BoxAcc {
+    const EMPTY: BoxAcc = BoxAcc { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn add_box(self, b: &Aabb) -> BoxAcc {
+        BoxAcc { min: self.min.min(Vec3A::from(b.min)), max: self.max.max(Vec3A::from(b.max)) }
+    }
+    #[inline(always)]
+    fn add_point(self, p: Vec3) -> BoxAcc {
+        let p = Vec3A::from(p);
+        BoxAcc { min: self.min.min(p), max: self.max.max(p) }
+    }
+    #[inline(always)]
+    fn union(self, o: BoxAcc) -> BoxAcc {
+        BoxAcc { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+    #[inline(always)]
+    fn aabb(self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
+    }
+}
+
 /// Builds the flat node array, the reordered primitive indices and the number of primitives in the tree.
 pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> (Vec<Node>, Vec<u32>, usize) {
     let (mut live, dead) = split_live(prims);
@@ -139,7 +171,7 @@ fn build_prim<P: Primitives + ?Sized>(prims: &P, i: usize) -> Option<BuildPrim> 
 
 /// Builds the subtree over `prims`, which sit at `offset` in the final index array.
 fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    let bounds = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_box(&p.bounds)).aabb();
     let Some(split) = find_split(prims, &bounds, depth, params) else {
         return make_leaf(bounds, offset, prims.len());
     };
@@ -168,7 +200,7 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
     if n == 1 {
         return None;
     }
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let cb = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_point(p.centroid)).aabb();
     let axis = cb.longest_axis();
     if cb.max[axis] <= cb.min[axis] {
         // All centroids coincide: no plane separates them. Split only to keep leaves bounded.
@@ -195,25 +227,25 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
 fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhParams) -> (usize, f64) {
     let nb = binner.bins;
     let mut counts = [0usize; super::MAX_BINS];
-    let mut boxes = [Aabb::EMPTY; super::MAX_BINS];
+    let mut boxes = [BoxAcc::EMPTY; super::MAX_BINS];
     for p in prims {
         let k = binner.bin(p.centroid);
         counts[k] += 1;
-        boxes[k] = boxes[k].union(p.bounds);
+        boxes[k] = boxes[k].add_box(&p.bounds);
     }
     // Right-to-left sweep: count times area of everything right of each plane.
     let mut right_cost = [0.0f64; super::MAX_BINS];
-    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    let (mut b, mut c) = (BoxAcc::EMPTY, 0usize);
     for k in (1..nb).rev() {
         b = b.union(boxes[k]);
         c += counts[k];
-        right_cost[k - 1] = c as f64 * b.area_f64();
+        right_cost[k - 1] = c as f64 * b.aabb().area_f64();
     }
     // A node of zero area (primitives on a line) makes every plane cost the same; the first one with
     // primitives on both sides wins, and that is all a degenerate node needs.
     let area = bounds.area_f64();
     let inv_area = if area > 0.0 { 1.0 / area } else { 0.0 };
-    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    let (mut b, mut c) = (BoxAcc::EMPTY, 0usize);
     let mut best = (0usize, f64::INFINITY);
     for k in 0..nb - 1 {
         b = b.union(boxes[k]);
@@ -222,7 +254,7 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
             continue;
         }
         let cost = params.traversal_cost as f64
-            + params.intersection_cost as f64 * (c as f64 * b.area_f64() + right_cost[k]) * inv_area;
+            + params.intersection_cost as f64 * (c as f64 * b.aabb().area_f64() + right_cost[k]) * inv_area;
         if cost < best.1 {
             best = (k, cost);
         }
