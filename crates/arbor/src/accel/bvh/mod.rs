@@ -193,7 +193,8 @@ pub struct Bvh {
     prim_indices: Vec<u32>,
     live: usize,
     wide: Wide,
-    stats: AccelStats,
+    kind: &'static str,
+    build_time: Duration,
 }
 
 impl Bvh {
@@ -231,9 +232,8 @@ impl Bvh {
         start: Instant,
     ) -> Bvh {
         let wide = Wide::collapse(&nodes, &prim_indices, live, prims);
-        let mut bvh = Bvh { nodes, prim_indices, live, wide, stats: AccelStats::default() };
-        bvh.stats = bvh.compute_stats(kind, start.elapsed());
-        bvh
+        // Statistics are computed when asked for (a walk over every node): not part of the build.
+        Bvh { nodes, prim_indices, live, wide, kind, build_time: start.elapsed() }
     }
 
     /// The flat node array; node 0 is the root (empty when no primitive can be hit).
@@ -328,7 +328,7 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn stats(&self) -> AccelStats {
-        self.stats.clone()
+        self.compute_stats(self.kind, self.build_time)
     }
 
     fn validate(&self, prims: &P) -> Result<(), String> {
