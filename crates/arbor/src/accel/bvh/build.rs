@@ -137,10 +137,13 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
 /// that cannot (empty or non-finite bounds), which every builder keeps out of the tree.
 pub(super) fn split_live<P: Primitives + ?Sized>(prims: &P) -> (Vec<BuildPrim>, Vec<u32>) {
     assert!(prims.len() <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
-    let all: Vec<(u32, Option<BuildPrim>)> =
-        (0..prims.len()).into_par_iter().map(|i| (i as u32, build_prim(prims, i))).collect();
-    let live = all.iter().filter_map(|(_, p)| *p).collect();
-    let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i).collect();
+    let live: Vec<BuildPrim> = (0..prims.len()).into_par_iter().filter_map(|i| build_prim(prims, i)).collect();
+    // Rare: look for the primitives left out only when there are some.
+    let dead = if live.len() < prims.len() {
+        (0..prims.len()).filter(|&i| build_prim(prims, i).is_none()).map(|i| i as u32).collect()
+    } else {
+        Vec::new()
+    };
     (live, dead)
 }
 
@@ -149,7 +152,9 @@ pub(super) fn split_live<P: Primitives + ?Sized>(prims: &P) -> (Vec<BuildPrim>, 
 pub(super) fn finish(root: Option<&BuildNode>, live: &[BuildPrim], dead: &[u32]) -> (Vec<Node>, Vec<u32>, usize) {
     let mut nodes = Vec::new();
     if let Some(root) = root {
-        nodes.reserve(count_nodes(root));
+        // About two nodes per leaf of a few primitives; growing past it costs a copy, cheaper than
+        // walking the tree to count.
+        nodes.reserve(live.len() / 2);
         flatten(root, &mut nodes);
     }
     let indices = live.iter().map(|p| p.index).chain(dead.iter().copied()).collect();
@@ -279,13 +284,6 @@ fn partition(prims: &mut [BuildPrim], split: Split) -> (usize, usize) {
             }
             (i, binner.axis)
         }
-    }
-}
-
-fn count_nodes(node: &BuildNode) -> usize {
-    match node {
-        BuildNode::Leaf { .. } => 1,
-        BuildNode::Inner { children, .. } => 1 + count_nodes(&children[0]) + count_nodes(&children[1]),
     }
 }
 
