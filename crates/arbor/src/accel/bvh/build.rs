@@ -41,8 +41,20 @@ pub(super) struct BuildPrim {
 
 /// The temporary tree, shared by every builder: leaves refer to ranges of the reordered primitives.
 pub(super) enum BuildNode {
-    Leaf { bounds: Aabb, first: u32, count: u16 },
-    Inner { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
+    Leaf {
+        bounds: Aabb,
+        first: u32,
+        count: u16,
+    },
+    Inner {
+        bounds: Aabb,
+        axis: u8,
+        children: Box<[BuildNode; 2]>,
+    },
+    /// A subtree already in the flat layout, second-child indices relative to its own first node (the
+    /// SAH builder writes subtrees below the parallel threshold this way: no boxed node to allocate,
+    /// walk and free for the bulk of the tree).
+    Flat(Vec<Node>),
 }
 
 /// How to split a node.
@@ -176,6 +188,11 @@ fn build_prim<P: Primitives + ?Sized>(prims: &P, i: usize) -> Option<BuildPrim> 
 
 /// Builds the subtree over `prims`, which sit at `offset` in the final index array.
 fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams) -> BuildNode {
+    if prims.len() < PARALLEL_THRESHOLD {
+        let mut out = Vec::with_capacity(prims.len() / 2);
+        build_flat(prims, offset, depth, params, &mut out);
+        return BuildNode::Flat(out);
+    }
     let bounds = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_box(&p.bounds)).aabb();
     let Some(split) = find_split(prims, &bounds, depth, params) else {
         return make_leaf(bounds, offset, prims.len());
@@ -191,6 +208,25 @@ fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &Bvh
         (build_node(left, offset, depth + 1, params), build_node(right, offset + mid, depth + 1, params))
     };
     BuildNode::Inner { bounds, axis: axis as u8, children: Box::new([l, r]) }
+}
+
+/// [`build_node`] for a subtree built on one thread: appends its nodes depth first to `out` (second-child
+/// indices relative to `out`'s start); returns the index of its root. Same decisions, same tree.
+fn build_flat(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams, out: &mut Vec<Node>) -> u32 {
+    let bounds = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_box(&p.bounds)).aabb();
+    let index = out.len() as u32;
+    let Some(split) = find_split(prims, &bounds, depth, params) else {
+        debug_assert!((1..=LEAF_HARD_MAX).contains(&prims.len()));
+        out.push(Node::leaf(bounds, offset as u32, prims.len() as u16));
+        return index;
+    };
+    let (mid, axis) = partition(prims, split);
+    let (left, right) = prims.split_at_mut(mid);
+    out.push(Node::inner(bounds, 0, axis as u8));
+    build_flat(left, offset, depth + 1, params, out);
+    let second = build_flat(right, offset + mid, depth + 1, params, out);
+    out[index as usize].offset = second;
+    index
 }
 
 /// A leaf over `count` primitives at `offset`.
@@ -297,6 +333,10 @@ fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
             flatten(&children[0], out);
             let second = flatten(&children[1], out);
             out[index] = Node::inner(*bounds, second, *axis);
+        }
+        BuildNode::Flat(nodes) => {
+            let base = index as u32;
+            out.extend(nodes.iter().map(|n| if n.is_leaf() { *n } else { Node { offset: n.offset + base, ..*n } }));
         }
     }
     index as u32
