@@ -176,7 +176,7 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    let Some(mut cur) = wide.root else { return None };
+    let mut cur = wide.root?;
     if trivially_misses(ray, t_max) {
         return None;
     }
@@ -271,6 +271,8 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
             sp -= 1;
             // SAFETY: entries below `sp` were written by the pushes above.
             let e = unsafe { stack[sp].assume_init() };
+            // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
             if !(e.near > t_far + e.slack) {
                 cur = e.r;
                 break;
