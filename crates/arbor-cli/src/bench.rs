@@ -32,14 +32,16 @@ pub struct BenchArgs {
     /// of about N triangles (e.g. sphere:1000000).
     pub input: String,
     /// Structures to compare: `all`, or a comma-separated list (brute,octree,kdtree,bvh-median,bvh-sah,
-    /// bvh-bottom-up).
-    #[arg(long, default_value = "all", value_parser = parse_accel_list)]
-    pub accel: AccelList,
+    /// bvh-bottom-up) [default: all; with a ray directory: bvh-sah].
+    #[arg(long, value_parser = parse_accel_list)]
+    pub accel: Option<AccelList>,
     /// A build parameter for one structure, KIND:KEY=VALUE (e.g. octree:leaf=16; repeatable).
     #[arg(long = "accel-param", value_name = "KIND:KEY=VALUE")]
     pub accel_params: Vec<String>,
-    /// Which ray sets to time.
-    #[arg(long, default_value = "both", value_parser = ["primary", "diffuse", "both"])]
+    /// Which ray sets to time: `primary`, `diffuse` or `both`; or a directory of ray files written by
+    /// `peerbench --dump-rays DIR` for the mesh INPUT, to trace exactly the peers' rays and print
+    /// peerbench's line format (see `docs/performance.md`).
+    #[arg(long, default_value = "both")]
     pub rays: String,
     /// Image size WxH, overriding the camera's resolution (the window stays: same view, fewer rays).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
@@ -106,8 +108,19 @@ struct SetResult {
 
 /// Runs `arbor bench`.
 pub fn run(args: BenchArgs) -> Result<(), Failure> {
+    let all = || AccelList(AccelKind::ALL.to_vec());
+    if !matches!(args.rays.as_str(), "primary" | "diffuse" | "both") {
+        // `all` leaves out brute force here: it would take hours on a million rays.
+        let kinds = match &args.accel {
+            None => vec![REFERENCE],
+            Some(a) if a.0 == AccelKind::ALL => a.0.iter().copied().filter(|&k| k != AccelKind::Brute).collect(),
+            Some(a) => a.0.clone(),
+        };
+        let specs = specs(&kinds, &args.accel_params)?;
+        return crate::bench_rays::run(&args, Path::new(&args.rays), &specs);
+    }
     crate::set_threads(args.threads)?;
-    let specs = specs(&args.accel.0, &args.accel_params)?;
+    let specs = specs(&args.accel.clone().unwrap_or_else(all).0, &args.accel_params)?;
     let desc = load_input(&args.input, args.size)?;
     arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
     if desc.cameras.is_empty() {

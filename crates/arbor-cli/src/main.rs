@@ -11,6 +11,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bench_rays;
 mod diff;
 mod info;
 mod merge;

@@ -87,6 +87,57 @@ fn bench_mesh_file_is_framed_by_default_camera() {
     assert!(hits > 40, "{out}");
 }
 
+/// One ray record of peerbench's `.rays` files and one `.hits` record.
+fn ray_record(o: [f32; 3], d: [f32; 3]) -> Vec<u8> {
+    [o[0], o[1], o[2], 0.0, d[0], d[1], d[2], f32::INFINITY].iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+fn hit_record(t: f32, prim: u32) -> Vec<u8> {
+    t.to_le_bytes().into_iter().chain(prim.to_le_bytes()).collect()
+}
+
+#[test]
+fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
+    let tmp = tempfile::tempdir().unwrap();
+    let off = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+    std::fs::write(tmp.path().join("quad.off"), off).unwrap();
+    let dir = tmp.path().join("rays");
+    std::fs::create_dir(&dir).unwrap();
+    // Two rays straight down onto the square (t = 2), one beside it; the reference is wrong on the third.
+    let rays = [
+        ([0.25, 0.5, 2.0], [0.0, 0.0, -1.0]),
+        ([0.75, 0.5, 2.0], [0.0, 0.0, -1.0]),
+        ([3.0, 0.5, 2.0], [0.0, 0.0, -1.0]),
+    ];
+    let bytes: Vec<u8> = rays.iter().flat_map(|(o, d)| ray_record(*o, *d)).collect();
+    let hits: Vec<u8> = [hit_record(2.0, 1), hit_record(2.0, 0), hit_record(5.0, 1)].concat();
+    for set in ["primary", "diffuse"] {
+        std::fs::write(dir.join(format!("{set}.rays")), &bytes).unwrap();
+        std::fs::write(dir.join(format!("{set}.hits")), &hits).unwrap();
+    }
+    let o = arbor(&["bench", "quad.off", "--rays", "rays", "--threads", "1", "--runs", "1"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("peer=")).collect();
+    assert_eq!(lines.len(), 2, "{out}");
+    for (line, set) in lines.iter().zip(["primary", "diffuse"]) {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(fields[..3], ["peer=arbor-bvh-sah", &format!("set={set}")[..], "threads=1"], "{line}");
+        assert!(fields[3].starts_with("build_ms=") && fields[4].starts_with("mrays="), "{line}");
+        assert_eq!(fields[5], "hits=2", "{line}");
+        assert!(line.contains("mismatch=0.333333"), "{line}");
+    }
+
+    // A truncated ray file is bad input (exit 3) named with its byte offset; a missing one an I/O error.
+    std::fs::write(dir.join("diffuse.rays"), &bytes[..40]).unwrap();
+    let o = arbor(&["bench", "quad.off", "--rays", "rays", "--runs", "1"], tmp.path());
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(stderr(&o).contains("diffuse.rays") && stderr(&o).contains("byte 32"), "{}", stderr(&o));
+    let o = arbor(&["bench", "quad.off", "--rays", "nowhere", "--runs", "1"], tmp.path());
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    assert!(stderr(&o).contains("primary.rays"), "{}", stderr(&o));
+}
+
 #[test]
 fn render_debug_views_write_images_and_report_the_heatmap_maximum() {
     let tmp = tempfile::tempdir().unwrap();

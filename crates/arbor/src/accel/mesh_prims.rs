@@ -36,6 +36,10 @@ impl Primitives for TriangleMesh {
         let [p, q, r] = self.triangle(i);
         clip_triangle_bounds(p, q, r, b)
     }
+
+    fn triangle_mesh(&self) -> Option<&TriangleMesh> {
+        Some(self)
+    }
 }
 
 #[cfg(test)]

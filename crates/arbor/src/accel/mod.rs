@@ -130,6 +130,12 @@ pub trait Primitives: Sync {
     fn clipped_bounds(&self, i: usize, b: &Aabb) -> Aabb {
         self.bounds(i).intersection(*b)
     }
+    /// The triangle mesh these primitives are, when they are one (primitive `i` is triangle `i`): lets a
+    /// structure keep the triangles' corners in its own leaf order and test them without going through
+    /// [`Primitives::intersect`], with the same triangle test and so the same hits.
+    fn triangle_mesh(&self) -> Option<&crate::geometry::TriangleMesh> {
+        None
+    }
 }
 
 /// The work one query did, for the traversal-cost heatmap and benchmarks.

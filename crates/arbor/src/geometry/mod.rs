@@ -11,6 +11,6 @@ mod triangle_clip;
 pub use mesh::{MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;
-pub use triangle::{intersect_triangle, TriHit};
+pub use triangle::{intersect_triangle, intersect_triangle_in, RayFrame, TriHit};
 pub use triangle_box::triangle_overlaps_box;
 pub use triangle_clip::clip_triangle_bounds;

@@ -25,33 +25,67 @@ fn permute(v: Vec3, kx: usize, ky: usize, kz: usize) -> Vec3 {
     Vec3::new(v[kx], v[ky], v[kz])
 }
 
+/// The part of the watertight test that depends only on the ray (the paper computes it once per ray):
+/// the axis permutation that makes the direction's largest component `z`, and the shear that maps the
+/// direction onto `+z`. Structures build it once per query and test every triangle with
+/// [`intersect_triangle_in`]; the arithmetic is the same, so the hits are bit for bit those of
+/// [`intersect_triangle`].
+#[derive(Debug, Clone, Copy)]
+pub struct RayFrame {
+    origin: Vec3,
+    dir: Vec3,
+    cull_backfaces: bool,
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl RayFrame {
+    /// The frame of `ray`.
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let ad = ray.dir.abs();
+        let kz = if ad.x > ad.y && ad.x > ad.z {
+            0
+        } else if ad.y > ad.z {
+            1
+        } else {
+            2
+        };
+        let kx = if kz == 2 { 0 } else { kz + 1 };
+        let ky = if kx == 2 { 0 } else { kx + 1 };
+        let d = permute(ray.dir, kx, ky, kz);
+        let sz = 1.0 / d.z;
+        let sx = -d.x * sz;
+        let sy = -d.y * sz;
+        RayFrame { origin: ray.origin, dir: ray.dir, cull_backfaces: ray.cull_backfaces, kx, ky, kz, sx, sy, sz }
+    }
+}
+
 /// The hit of `ray` with triangle `(p0, p1, p2)` in `(0, t_max)`, if any. With `ray.cull_backfaces`,
 /// triangles whose counter-clockwise side faces away from the ray are skipped.
 #[inline]
 pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriHit> {
-    if ray.cull_backfaces && ray.dir.dot((p1 - p0).cross(p2 - p0)) >= 0.0 {
+    intersect_triangle_in(&RayFrame::new(ray), p0, p1, p2, t_max)
+}
+
+/// [`intersect_triangle`] for a ray whose [`RayFrame`] is already known (always inlined: it is the
+/// body of every structure's leaf loop).
+#[inline(always)]
+pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<TriHit> {
+    if f.cull_backfaces && f.dir.dot((p1 - p0).cross(p2 - p0)) >= 0.0 {
         return None;
     }
-    let d = ray.dir;
-    let ad = d.abs();
-    let kz = if ad.x > ad.y && ad.x > ad.z {
-        0
-    } else if ad.y > ad.z {
-        1
-    } else {
-        2
-    };
-    let kx = if kz == 2 { 0 } else { kz + 1 };
-    let ky = if kx == 2 { 0 } else { kx + 1 };
-    let d = permute(d, kx, ky, kz);
-    let mut a = permute(p0 - ray.origin, kx, ky, kz);
-    let mut b = permute(p1 - ray.origin, kx, ky, kz);
-    let mut c = permute(p2 - ray.origin, kx, ky, kz);
+    let (kx, ky, kz) = (f.kx, f.ky, f.kz);
+    let mut a = permute(p0 - f.origin, kx, ky, kz);
+    let mut b = permute(p1 - f.origin, kx, ky, kz);
+    let mut c = permute(p2 - f.origin, kx, ky, kz);
     let (a0, b0, c0) = (a, b, c);
 
-    let sz = 1.0 / d.z;
-    let sx = -d.x * sz;
-    let sy = -d.y * sz;
+    let (sx, sy, sz) = (f.sx, f.sy, f.sz);
     a.x += sx * a.z;
     a.y += sy * a.z;
     b.x += sx * b.z;
@@ -63,7 +97,7 @@ pub fn intersect_triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -
     let mut e1 = c.x * a.y - c.y * a.x;
     let mut e2 = a.x * b.y - a.y * b.x;
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        [e0, e1, e2] = edges_f64(d, [a0, b0, c0]);
+        [e0, e1, e2] = edges_f64(permute(f.dir, kx, ky, kz), [a0, b0, c0]);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;

@@ -13,15 +13,17 @@
 //! nodes build their halves with `rayon::join`; since each half owns a disjoint slice of the primitive
 //! array and every decision depends only on that slice, the result is identical for any thread count.
 //!
-//! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices and areas
-//! are computed in double precision, so centroids spanning the whole float range neither overflow nor
-//! produce NaN bins.
+//! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices are computed
+//! in single precision when the centroid extent and the bin scale are finite in it, else in double
+//! precision, so centroids spanning the whole float range neither overflow nor produce NaN bins; areas
+//! are always double precision.
 
 use rayon::prelude::*;
 
 use super::{BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
 use crate::accel::Primitives;
 use crate::math::{Aabb, Vec3};
+use glam::Vec3A;
 
 /// Nodes with at least this many primitives build their two children in parallel.
 pub(super) const PARALLEL_THRESHOLD: usize = 4096;
@@ -39,8 +41,20 @@ pub(super) struct BuildPrim {
 
 /// The temporary tree, shared by every builder: leaves refer to ranges of the reordered primitives.
 pub(super) enum BuildNode {
-    Leaf { bounds: Aabb, first: u32, count: u16 },
-    Inner { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
+    Leaf {
+        bounds: Aabb,
+        first: u32,
+        count: u16,
+    },
+    Inner {
+        bounds: Aabb,
+        axis: u8,
+        children: Box<[BuildNode; 2]>,
+    },
+    /// A subtree already in the flat layout, second-child indices relative to its own first node (the
+    /// SAH builder writes subtrees below the parallel threshold this way: no boxed node to allocate,
+    /// walk and free for the bulk of the tree).
+    Flat(Vec<Node>),
 }
 
 /// How to split a node.
@@ -58,16 +72,69 @@ struct Binner {
     axis: usize,
     min: f64,
     scale: f64,
+    /// The same map in single precision, used when the extent and the scale are finite in it (always,
+    /// but for centroids spanning most of the float range): cheaper per primitive.
+    min32: f32,
+    scale32: f32,
+    single: bool,
     bins: usize,
 }
 
 impl Binner {
+    fn new(axis: usize, min: f32, max: f32, bins: usize) -> Binner {
+        let scale32 = bins as f32 / (max - min);
+        Binner {
+            axis,
+            min: min as f64,
+            scale: bins as f64 / (max as f64 - min as f64),
+            min32: min,
+            scale32,
+            single: (max - min).is_finite() && scale32.is_finite() && scale32 > 0.0,
+            bins,
+        }
+    }
+
     #[inline]
     fn bin(&self, c: Vec3) -> usize {
         // The minimum centroid lands in bin 0 and the maximum in the last bin (the ratio rounds to
         // `bins` or just below), so every candidate plane has primitives on both sides.
-        let k = ((c[self.axis] as f64 - self.min) * self.scale) as usize;
+        let k = if self.single {
+            ((c[self.axis] - self.min32) * self.scale32) as usize
+        } else {
+            ((c[self.axis] as f64 - self.min) * self.scale) as usize
+        };
         k.min(self.bins - 1)
+    }
+}
+
+/// A box being grown, in SIMD lanes (glam's `Vec3A`: one `minps`/`maxps` per union on x86_64, where
+/// `Aabb`'s `f32::min`/`max` take three NaN-aware instructions per axis). The builder's boxes are all
+/// finite, so the results are exactly `Aabb::union`'s; this is most of the build's arithmetic.
+#[derive(Debug, Clone, Copy)]
+struct BoxAcc {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl BoxAcc {
+    const EMPTY: BoxAcc = BoxAcc { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn add_box(self, b: &Aabb) -> BoxAcc {
+        BoxAcc { min: self.min.min(Vec3A::from(b.min)), max: self.max.max(Vec3A::from(b.max)) }
+    }
+    #[inline(always)]
+    fn add_point(self, p: Vec3) -> BoxAcc {
+        let p = Vec3A::from(p);
+        BoxAcc { min: self.min.min(p), max: self.max.max(p) }
+    }
+    #[inline(always)]
+    fn union(self, o: BoxAcc) -> BoxAcc {
+        BoxAcc { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+    #[inline(always)]
+    fn aabb(self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
     }
 }
 
@@ -82,10 +149,13 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
 /// that cannot (empty or non-finite bounds), which every builder keeps out of the tree.
 pub(super) fn split_live<P: Primitives + ?Sized>(prims: &P) -> (Vec<BuildPrim>, Vec<u32>) {
     assert!(prims.len() <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
-    let all: Vec<(u32, Option<BuildPrim>)> =
-        (0..prims.len()).into_par_iter().map(|i| (i as u32, build_prim(prims, i))).collect();
-    let live = all.iter().filter_map(|(_, p)| *p).collect();
-    let dead = all.iter().filter(|(_, p)| p.is_none()).map(|(i, _)| *i).collect();
+    let live: Vec<BuildPrim> = (0..prims.len()).into_par_iter().filter_map(|i| build_prim(prims, i)).collect();
+    // Rare: look for the primitives left out only when there are some.
+    let dead = if live.len() < prims.len() {
+        (0..prims.len()).filter(|&i| build_prim(prims, i).is_none()).map(|i| i as u32).collect()
+    } else {
+        Vec::new()
+    };
     (live, dead)
 }
 
@@ -94,7 +164,9 @@ pub(super) fn split_live<P: Primitives + ?Sized>(prims: &P) -> (Vec<BuildPrim>, 
 pub(super) fn finish(root: Option<&BuildNode>, live: &[BuildPrim], dead: &[u32]) -> (Vec<Node>, Vec<u32>, usize) {
     let mut nodes = Vec::new();
     if let Some(root) = root {
-        nodes.reserve(count_nodes(root));
+        // About two nodes per leaf of a few primitives; growing past it costs a copy, cheaper than
+        // walking the tree to count.
+        nodes.reserve(live.len() / 2);
         flatten(root, &mut nodes);
     }
     let indices = live.iter().map(|p| p.index).chain(dead.iter().copied()).collect();
@@ -116,7 +188,12 @@ fn build_prim<P: Primitives + ?Sized>(prims: &P, i: usize) -> Option<BuildPrim> 
 
 /// Builds the subtree over `prims`, which sit at `offset` in the final index array.
 fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    if prims.len() < PARALLEL_THRESHOLD {
+        let mut out = Vec::with_capacity(prims.len() / 2);
+        build_flat(prims, offset, depth, params, &mut out);
+        return BuildNode::Flat(out);
+    }
+    let bounds = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_box(&p.bounds)).aabb();
     let Some(split) = find_split(prims, &bounds, depth, params) else {
         return make_leaf(bounds, offset, prims.len());
     };
@@ -133,6 +210,25 @@ fn build_node(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &Bvh
     BuildNode::Inner { bounds, axis: axis as u8, children: Box::new([l, r]) }
 }
 
+/// [`build_node`] for a subtree built on one thread: appends its nodes depth first to `out` (second-child
+/// indices relative to `out`'s start); returns the index of its root. Same decisions, same tree.
+fn build_flat(prims: &mut [BuildPrim], offset: usize, depth: usize, params: &BvhParams, out: &mut Vec<Node>) -> u32 {
+    let bounds = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_box(&p.bounds)).aabb();
+    let index = out.len() as u32;
+    let Some(split) = find_split(prims, &bounds, depth, params) else {
+        debug_assert!((1..=LEAF_HARD_MAX).contains(&prims.len()));
+        out.push(Node::leaf(bounds, offset as u32, prims.len() as u16));
+        return index;
+    };
+    let (mid, axis) = partition(prims, split);
+    let (left, right) = prims.split_at_mut(mid);
+    out.push(Node::inner(bounds, 0, axis as u8));
+    build_flat(left, offset, depth + 1, params, out);
+    let second = build_flat(right, offset + mid, depth + 1, params, out);
+    out[index as usize].offset = second;
+    index
+}
+
 /// A leaf over `count` primitives at `offset`.
 pub(super) fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode {
     debug_assert!((1..=LEAF_HARD_MAX).contains(&count));
@@ -145,7 +241,7 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
     if n == 1 {
         return None;
     }
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let cb = prims.iter().fold(BoxAcc::EMPTY, |b, p| b.add_point(p.centroid)).aabb();
     let axis = cb.longest_axis();
     if cb.max[axis] <= cb.min[axis] {
         // All centroids coincide: no plane separates them. Split only to keep leaves bounded.
@@ -154,12 +250,7 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
     if depth >= MAX_SAH_DEPTH {
         return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
     }
-    let binner = Binner {
-        axis,
-        min: cb.min[axis] as f64,
-        scale: params.bins as f64 / (cb.max[axis] as f64 - cb.min[axis] as f64),
-        bins: params.bins,
-    };
+    let binner = Binner::new(axis, cb.min[axis], cb.max[axis], params.bins);
     let (bin, cost) = best_bin(prims, bounds, &binner, params);
     if !cost.is_finite() {
         // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
@@ -177,25 +268,25 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
 fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhParams) -> (usize, f64) {
     let nb = binner.bins;
     let mut counts = [0usize; super::MAX_BINS];
-    let mut boxes = [Aabb::EMPTY; super::MAX_BINS];
+    let mut boxes = [BoxAcc::EMPTY; super::MAX_BINS];
     for p in prims {
         let k = binner.bin(p.centroid);
         counts[k] += 1;
-        boxes[k] = boxes[k].union(p.bounds);
+        boxes[k] = boxes[k].add_box(&p.bounds);
     }
     // Right-to-left sweep: count times area of everything right of each plane.
     let mut right_cost = [0.0f64; super::MAX_BINS];
-    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    let (mut b, mut c) = (BoxAcc::EMPTY, 0usize);
     for k in (1..nb).rev() {
         b = b.union(boxes[k]);
         c += counts[k];
-        right_cost[k - 1] = c as f64 * b.area_f64();
+        right_cost[k - 1] = c as f64 * b.aabb().area_f64();
     }
     // A node of zero area (primitives on a line) makes every plane cost the same; the first one with
     // primitives on both sides wins, and that is all a degenerate node needs.
     let area = bounds.area_f64();
     let inv_area = if area > 0.0 { 1.0 / area } else { 0.0 };
-    let (mut b, mut c) = (Aabb::EMPTY, 0usize);
+    let (mut b, mut c) = (BoxAcc::EMPTY, 0usize);
     let mut best = (0usize, f64::INFINITY);
     for k in 0..nb - 1 {
         b = b.union(boxes[k]);
@@ -204,7 +295,7 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
             continue;
         }
         let cost = params.traversal_cost as f64
-            + params.intersection_cost as f64 * (c as f64 * b.area_f64() + right_cost[k]) * inv_area;
+            + params.intersection_cost as f64 * (c as f64 * b.aabb().area_f64() + right_cost[k]) * inv_area;
         if cost < best.1 {
             best = (k, cost);
         }
@@ -232,13 +323,6 @@ fn partition(prims: &mut [BuildPrim], split: Split) -> (usize, usize) {
     }
 }
 
-fn count_nodes(node: &BuildNode) -> usize {
-    match node {
-        BuildNode::Leaf { .. } => 1,
-        BuildNode::Inner { children, .. } => 1 + count_nodes(&children[0]) + count_nodes(&children[1]),
-    }
-}
-
 /// Appends `node`'s subtree depth first (first child right after its parent); returns its index.
 fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
     let index = out.len();
@@ -249,6 +333,10 @@ fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
             flatten(&children[0], out);
             let second = flatten(&children[1], out);
             out[index] = Node::inner(*bounds, second, *axis);
+        }
+        BuildNode::Flat(nodes) => {
+            let base = index as u32;
+            out.extend(nodes.iter().map(|n| if n.is_leaf() { *n } else { Node { offset: n.offset + base, ..*n } }));
         }
     }
     index as u32

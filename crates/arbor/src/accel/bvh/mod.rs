@@ -30,10 +30,12 @@ mod build;
 mod median;
 mod traverse;
 mod validate;
+mod wide;
 
 use std::time::{Duration, Instant};
 
 pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
+pub use wide::{Node4, Wide};
 
 use super::params::{parse_value, unknown_key};
 use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
@@ -190,7 +192,9 @@ pub struct Bvh {
     nodes: Vec<Node>,
     prim_indices: Vec<u32>,
     live: usize,
-    stats: AccelStats,
+    wide: Wide,
+    kind: &'static str,
+    build_time: Duration,
 }
 
 impl Bvh {
@@ -198,7 +202,7 @@ impl Bvh {
     pub fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
         let start = Instant::now();
         let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
-        Bvh::from_flat(nodes, prim_indices, live, "bvh-sah", start)
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start)
     }
 
     /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
@@ -207,28 +211,29 @@ impl Bvh {
         let start = Instant::now();
         let bvh_params = BvhParams { max_leaf_prims: params.max_leaf_prims, ..BvhParams::default() };
         let (nodes, prim_indices, live) = median::build_median(prims, &bvh_params.sanitized());
-        Bvh::from_flat(nodes, prim_indices, live, "bvh-median", start)
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-median", start)
     }
 
     /// Builds a BVH over `prims` bottom-up, by the exact greedy method or PLOC (see `bottom_up/`).
     pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams) -> Bvh {
         let start = Instant::now();
         let (nodes, prim_indices, live) = bottom_up::build(prims, params);
-        Bvh::from_flat(nodes, prim_indices, live, "bvh-bottom-up", start)
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-bottom-up", start)
     }
 
     /// Wraps a flat node array written by any builder (the traversal and checks are shared), and
     /// records the build time since `start`.
-    pub(crate) fn from_flat(
+    pub(crate) fn from_flat<P: Primitives + ?Sized>(
+        prims: &P,
         nodes: Vec<Node>,
         prim_indices: Vec<u32>,
         live: usize,
         kind: &'static str,
         start: Instant,
     ) -> Bvh {
-        let mut bvh = Bvh { nodes, prim_indices, live, stats: AccelStats::default() };
-        bvh.stats = bvh.compute_stats(kind, start.elapsed());
-        bvh
+        let wide = Wide::collapse(&nodes, &prim_indices, live, prims);
+        // Statistics are computed when asked for (a walk over every node): not part of the build.
+        Bvh { nodes, prim_indices, live, wide, kind, build_time: start.elapsed() }
     }
 
     /// The flat node array; node 0 is the root (empty when no primitive can be hit).
@@ -248,7 +253,8 @@ impl Bvh {
             nodes: self.nodes.len(),
             bytes: std::mem::size_of::<Self>()
                 + self.nodes.len() * std::mem::size_of::<Node>()
-                + self.prim_indices.len() * std::mem::size_of::<u32>(),
+                + self.prim_indices.len() * std::mem::size_of::<u32>()
+                + self.wide.bytes(),
             build_time,
             ..AccelStats::default()
         };
@@ -295,18 +301,11 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
-        traverse::intersect::<P, false>(
-            &self.nodes,
-            &self.prim_indices,
-            prims,
-            ray,
-            t_max,
-            &mut TraversalCounts::default(),
-        )
+        wide::intersect::<P, false>(&self.wide, &self.prim_indices, prims, ray, t_max, &mut TraversalCounts::default())
     }
 
     fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
-        traverse::intersect::<P, true>(&self.nodes, &self.prim_indices, prims, ray, t_max, counts)
+        wide::intersect::<P, true>(&self.wide, &self.prim_indices, prims, ray, t_max, counts)
     }
 
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
@@ -325,11 +324,11 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
-        traverse::occluded(&self.nodes, &self.prim_indices, prims, ray, t_max)
+        wide::occluded(&self.wide, &self.prim_indices, prims, ray, t_max)
     }
 
     fn stats(&self) -> AccelStats {
-        self.stats.clone()
+        self.compute_stats(self.kind, self.build_time)
     }
 
     fn validate(&self, prims: &P) -> Result<(), String> {

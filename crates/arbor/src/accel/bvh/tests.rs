@@ -209,7 +209,9 @@ fn bvh_stats_describe_the_tree() {
     assert_eq!(s.nodes, 2 * s.leaves - 1);
     assert!(s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0, "{s:?}");
     assert!(s.sah_cost > 1.0 && s.sah_cost < 10_000.0, "{s:?}");
-    assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000);
+    // Binary nodes and indices, the 4-wide nodes, and the triangles' corners in leaf order.
+    let wide = 128 * bvh.wide.nodes().len() + 36 * 10_000;
+    assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000 + wide);
 }
 
 #[test]
@@ -314,4 +316,38 @@ fn median_sah_cost_is_within_a_sane_factor_of_binned_sah() {
     let (median, binned) =
         (Bvh::build_median(&mesh, &MedianParams::default()), Bvh::build_sah(&mesh, &BvhParams::default()));
     assert!(sah(&median) < 2.0 * sah(&binned), "median {} binned {}", sah(&median), sah(&binned));
+}
+
+/// Primitives that are not a mesh, so the wide tree asks them through `Primitives` (no triangle copy).
+struct Opaque<'a>(&'a TriangleMesh);
+
+impl Primitives for Opaque<'_> {
+    fn len(&self) -> usize {
+        Primitives::len(self.0)
+    }
+    fn bounds(&self, i: usize) -> Aabb {
+        Primitives::bounds(self.0, i)
+    }
+    fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<crate::accel::PrimHit> {
+        Primitives::intersect(self.0, i, ray, t_max)
+    }
+}
+
+#[test]
+fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() {
+    let mesh = soup(3000, 17);
+    let opaque = Opaque(&mesh);
+    let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+    let without = Bvh::build_sah(&opaque, &BvhParams::default());
+    assert!(with_copy.wide.bytes() > without.wide.bytes(), "a mesh gets its triangles copied in leaf order");
+    for ray in rays(2000, 5) {
+        let mut c = TraversalCounts::default();
+        let binary =
+            traverse::intersect::<_, false>(&with_copy.nodes, &with_copy.prim_indices, &mesh, &ray, 30.0, &mut c);
+        assert_eq!(with_copy.intersect(&mesh, &ray, 30.0), binary, "{ray:?}");
+        assert_eq!(without.intersect(&opaque, &ray, 30.0), binary, "{ray:?}");
+        let occ = traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, &ray, 4.0);
+        assert_eq!(with_copy.occluded(&mesh, &ray, 4.0), occ);
+        assert_eq!(without.occluded(&opaque, &ray, 4.0), occ);
+    }
 }

@@ -20,14 +20,22 @@
 //!   and `min` ignore the NaN, which treats the ray as inside that slab, the closed-box answer.
 //!
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
+//!
+//! Queries now run on the 4-wide form of the tree (`wide/`), whose exactness rests on this argument;
+//! this binary traversal is kept for tests, which check that both give the same hits.
 
+#[cfg(test)]
 use super::{Node, MAX_DEPTH};
+#[cfg(test)]
 use crate::accel::{Hit, Primitives, TraversalCounts};
+#[cfg(test)]
 use crate::math::Ray;
 
+#[cfg(test)]
 /// The shared slack of box and interval tests ([`crate::accel::BOX_SLACK`]).
 const SLACK: f32 = crate::accel::BOX_SLACK;
 
+#[cfg(test)]
 /// A ray prepared for slab tests.
 struct RayBoxTest {
     origin: [f32; 3],
@@ -37,6 +45,7 @@ struct RayBoxTest {
     major: usize,
 }
 
+#[cfg(test)]
 impl RayBoxTest {
     fn new(ray: &Ray) -> Self {
         let inv = ray.inv_dir;
@@ -87,15 +96,17 @@ impl RayBoxTest {
     }
 }
 
+#[cfg(test)]
 /// True when no structure query can hit anything: invalid ray, empty tree, or an empty `(0, t_max)`.
 #[inline]
 fn trivially_misses(nodes: &[Node], ray: &Ray, t_max: f32) -> bool {
     nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
 }
 
+#[cfg(test)]
 /// The closest hit in `(0, t_max)`, ties to the lowest primitive index. With `COUNT`, the nodes visited
 /// and primitives tested are added to `counts` (compiled out otherwise).
-pub(super) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
+pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
     nodes: &[Node],
     indices: &[u32],
     prims: &P,
@@ -153,8 +164,9 @@ pub(super) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
     }
 }
 
+#[cfg(test)]
 /// Whether anything is hit in `(0, t_max)`; stops at the first hit.
-pub(super) fn occluded<P: Primitives + ?Sized>(
+pub(crate) fn occluded<P: Primitives + ?Sized>(
     nodes: &[Node],
     indices: &[u32],
     prims: &P,
@@ -195,7 +207,7 @@ pub(super) fn occluded<P: Primitives + ?Sized>(
 
 /// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
 #[inline]
-fn next_up(t: f32) -> f32 {
+pub(super) fn next_up(t: f32) -> f32 {
     if t.is_finite() && t >= 0.0 {
         f32::from_bits(t.to_bits() + 1)
     } else {

@@ -6,6 +6,10 @@
 //! came from, the origin pushed off by `1e-5` of the scene's bounding-box diagonal. Every ray draws from
 //! its own random stream seeded by its index, so the sets do not depend on the thread count. The same
 //! rays are traced by every structure, and their hits compared exactly (primitive and `t`).
+//!
+//! [`ray_files`] reads the rays peerbench dumped (`--dump-rays`), to trace exactly the peers' rays.
+
+pub mod ray_files;
 
 use std::path::Path;
 use std::sync::Arc;

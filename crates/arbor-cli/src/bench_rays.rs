@@ -1,0 +1,167 @@
+//! `arbor bench MESH --rays DIR`: traces the rays the peers' harness dumped (`peerbench --dump-rays
+//! DIR`) with Arbor's structures over the same mesh, and prints one line per (structure, ray set) in
+//! peerbench's own format, so that one script can put Arbor and the peers side by side on identical rays.
+//!
+//! Measured as peerbench measures its peers: one untimed warm-up build of a small mesh, then the
+//! median of `--runs` builds of the mesh (wall time from the loaded mesh to a traceable structure);
+//! each ray set traced at least 3 times and for at least 0.3 s (stopping after 2.5 s), median rate.
+//! One thread traces on the calling thread; more threads trace 1024-ray chunks on the rayon pool.
+//! `mismatch` is the share of rays whose hit disagrees with the reference peer's (hit or miss, or `t`
+//! off by more than 1e-4 relative, see [`disagrees`]).
+//!
+//! Each line also gives `cpu_build_ms` and `cpu_mrays`, the same medians in process CPU time
+//! (`getrusage`): on a machine shared with other jobs, wall time counts the time the scheduler gave
+//! to others, CPU time does not. Ratios to the peers use wall time, as the peers report only that.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use arbor::accel::{build_with, Accel, AccelSpec};
+use arbor::bench::ray_files::{disagrees, load_ray_set, FileRay, RaySetFile};
+use arbor::bench::sphere_mesh;
+use arbor::geometry::TriangleMesh;
+use rayon::prelude::*;
+
+use crate::bench::BenchArgs;
+use crate::Failure;
+
+/// Rays per parallel work item (peerbench's chunk size).
+const CHUNK: usize = 1024;
+/// Every set is traced for at least this long in total...
+const MIN_TIME: Duration = Duration::from_millis(300);
+/// ...and at least this many times, but no more passes start after [`MAX_TIME`].
+const MIN_RUNS: usize = 3;
+const MAX_TIME: Duration = Duration::from_millis(2500);
+
+/// Runs `arbor bench MESH --rays DIR` for the structures of `kinds`.
+pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Failure> {
+    crate::set_threads(args.threads)?;
+    let threads = args.threads.unwrap_or_else(rayon::current_num_threads).max(1);
+    let path = Path::new(&args.input);
+    let start = Instant::now();
+    let mesh = arbor::mesh_io::load_mesh(path)?;
+    let load = start.elapsed();
+    let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    say!(
+        "# mesh={} tris={} load_ms={:.1} ({:.0} MB/s)",
+        args.input,
+        mesh.len(),
+        load.as_secs_f64() * 1e3,
+        bytes as f64 / load.as_secs_f64().max(1e-9) / 1e6
+    );
+    let sets = [load_ray_set(dir, "primary")?, load_ray_set(dir, "diffuse")?];
+    let warm_up = sphere_mesh(2000);
+    for spec in kinds {
+        drop(build_with(spec, &warm_up).map_err(arbor::Error::Invalid)?);
+        let mut builds = Vec::new();
+        let mut cpu_builds = Vec::new();
+        let mut accel = None;
+        for _ in 0..args.runs {
+            drop(accel.take());
+            let (start, cpu) = (Instant::now(), cpu_time());
+            let built = build_with(spec, &mesh).map_err(arbor::Error::Invalid)?;
+            builds.push(start.elapsed().as_secs_f64() * 1e3);
+            cpu_builds.push((cpu_time() - cpu).as_secs_f64() * 1e3);
+            accel = Some(built);
+        }
+        let Some(accel) = accel else { continue };
+        let build_ms = median(&mut builds);
+        let cpu_build_ms = median(&mut cpu_builds);
+        let list: Vec<String> = builds.iter().map(|b| format!("{b:.1}")).collect();
+        say!("# peer=arbor-{} built in {} ms", spec.kind, list.join(", "));
+        for set in &sets {
+            let r = measure(accel.as_ref(), &mesh, set, threads);
+            say!(
+                "peer=arbor-{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} tris={} \
+                 rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} cpu_mrays={:.3}",
+                spec.kind,
+                set.name,
+                r.mrays,
+                r.hits,
+                path.file_name().map_or_else(|| args.input.clone(), |f| f.to_string_lossy().into_owned()),
+                mesh.len(),
+                set.rays.len(),
+                r.runs,
+                r.mismatch,
+                r.cpu_mrays
+            );
+        }
+    }
+    Ok(())
+}
+
+struct Measured {
+    mrays: f64,
+    cpu_mrays: f64,
+    hits: usize,
+    runs: usize,
+    mismatch: f64,
+}
+
+fn measure(accel: &dyn Accel<TriangleMesh>, mesh: &TriangleMesh, set: &RaySetFile, threads: usize) -> Measured {
+    let trace = |out: &mut Vec<Option<f32>>| {
+        let (start, cpu) = (Instant::now(), cpu_time());
+        trace_all(accel, mesh, &set.rays, threads, out);
+        (start.elapsed(), cpu_time() - cpu)
+    };
+    let mut ts = vec![None; set.rays.len()];
+    let mut times = Vec::new();
+    let mut cpu_times = Vec::new();
+    let mut total = Duration::ZERO;
+    while times.len() < MIN_RUNS || total < MIN_TIME {
+        let (dt, cpu) = trace(&mut ts);
+        total += dt;
+        times.push(dt.as_secs_f64());
+        cpu_times.push(cpu.as_secs_f64());
+        if total > MAX_TIME {
+            break;
+        }
+    }
+    let secs = median(&mut times).max(1e-9);
+    let wrong = ts.iter().zip(&set.hits).filter(|(t, r)| disagrees(**t, r)).count();
+    Measured {
+        mrays: set.rays.len() as f64 / secs / 1e6,
+        cpu_mrays: set.rays.len() as f64 / median(&mut cpu_times).max(1e-9) / 1e6,
+        hits: ts.iter().flatten().count(),
+        runs: times.len(),
+        mismatch: wrong as f64 / set.rays.len().max(1) as f64,
+    }
+}
+
+/// Closest-hit distances of `rays` into `out`: on this thread for one thread, else in chunks on rayon.
+fn trace_all(
+    accel: &dyn Accel<TriangleMesh>,
+    mesh: &TriangleMesh,
+    rays: &[FileRay],
+    threads: usize,
+    out: &mut [Option<f32>],
+) {
+    let one = |r: &FileRay| accel.intersect(mesh, &r.ray, r.t_max).map(|h| h.t);
+    if threads == 1 {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = one(r);
+        }
+    } else {
+        out.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(o, r)| {
+            for (o, r) in o.iter_mut().zip(r) {
+                *o = one(r);
+            }
+        });
+    }
+}
+
+fn median(xs: &mut [f64]) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    xs.get(xs.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// CPU time of the whole process so far (user and system, every thread).
+fn cpu_time() -> Duration {
+    // SAFETY: `getrusage` only writes the struct it is given, which is plain old data.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return Duration::ZERO;
+    }
+    let tv = |t: libc::timeval| Duration::new(t.tv_sec.max(0) as u64, (t.tv_usec.max(0) as u32) * 1000);
+    tv(u.ru_utime) + tv(u.ru_stime)
+}

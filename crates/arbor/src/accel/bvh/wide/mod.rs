@@ -1,0 +1,131 @@
+//! The 4-wide form of a binary BVH, which is what queries traverse (Wald, Benthin and Boulos 2008,
+//! "Getting rid of packets"; Embree's BVH4): every binary tree, whatever its builder, is collapsed
+//! into nodes of up to four children whose boxes are stored as structure-of-arrays `f32` lanes, so
+//! one ray is tested against four boxes at once (`traverse.rs`, SSE).
+//!
+//! Collapse: starting from a binary node's two children, the inner child with the largest surface area
+//! is repeatedly replaced by its own two children until there are four, or only leaves (the SAH
+//! probability of being visited decides which level to skip). Leaves keep their ranges of the binary
+//! tree's primitive order.
+//!
+//! When the primitives are a triangle mesh ([`Primitives::triangle_mesh`]), the corners of every
+//! triangle are copied in leaf order (`tris[k]` is triangle `prim_indices[k]`), so the leaf loop reads
+//! consecutive memory instead of chasing two indices per triangle; the test is the same watertight
+//! test on the same corner values, so hits are bit for bit those of brute force. Other primitives are
+//! asked through [`Primitives::intersect`].
+//!
+//! Cost: 128 bytes per node (about `n / (2.5 * leaf size)` nodes), 36 bytes per triangle; the collapse
+//! is linear in the binary tree's size.
+
+mod traverse;
+
+pub(super) use traverse::{intersect, occluded};
+
+use super::Node;
+use crate::accel::Primitives;
+use crate::math::Vec3;
+
+/// One 4-wide node: boxes of up to four children as lanes (`[axis][lane]`), and what each child is.
+/// Unused lanes have an inverted infinite box (min `+inf`, max `-inf`), which every ray misses.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+pub struct Node4 {
+    /// Lower corners, per axis then lane.
+    pub min: [[f32; 4]; 3],
+    /// Upper corners, per axis then lane.
+    pub max: [[f32; 4]; 3],
+    /// Per lane: the child node's index (inner child), or its first primitive in leaf order (leaf).
+    pub child: [u32; 4],
+    /// Per lane: 0 for an inner child (or an unused lane), else the leaf's primitive count.
+    pub count: [u32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+
+impl Node4 {
+    const EMPTY: Node4 =
+        Node4 { min: [[f32::INFINITY; 4]; 3], max: [[f32::NEG_INFINITY; 4]; 3], child: [u32::MAX; 4], count: [0; 4] };
+}
+
+/// A reference to a subtree: an inner node (`count == 0`) or a leaf.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Ref {
+    pub child: u32,
+    pub count: u32,
+}
+
+/// The 4-wide tree and, for triangle meshes, the triangles in leaf order.
+#[derive(Debug, Clone, Default)]
+pub struct Wide {
+    nodes: Vec<Node4>,
+    /// The root: node 0, or a single leaf; `None` for an empty tree.
+    root: Option<Ref>,
+    tris: Option<Vec<[Vec3; 3]>>,
+}
+
+impl Wide {
+    /// Collapses the binary tree `bin` (depth-first layout) whose leaves refer to `indices`.
+    pub(super) fn collapse<P: Primitives + ?Sized>(bin: &[Node], indices: &[u32], live: usize, prims: &P) -> Wide {
+        let tris =
+            prims.triangle_mesh().map(|mesh| indices[..live].iter().map(|&i| mesh.triangle(i as usize)).collect());
+        let Some(root) = bin.first() else {
+            return Wide { nodes: Vec::new(), root: None, tris };
+        };
+        if root.is_leaf() {
+            let root = Ref { child: root.offset, count: root.count as u32 };
+            return Wide { nodes: Vec::new(), root: Some(root), tris };
+        }
+        let mut nodes = Vec::with_capacity(bin.len() / 2);
+        collapse_node(bin, 0, &mut nodes);
+        Wide { nodes, root: Some(Ref { child: 0, count: 0 }), tris }
+    }
+
+    /// Bytes of the wide nodes and the triangle copy.
+    pub fn bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node4>()
+            + self.tris.as_ref().map_or(0, |t| t.len() * std::mem::size_of::<[Vec3; 3]>())
+    }
+
+    /// The wide nodes (node 0 is the root when the root is not a leaf).
+    pub fn nodes(&self) -> &[Node4] {
+        &self.nodes
+    }
+}
+
+/// Writes the wide node for binary inner node `i` and its subtree; returns its index.
+fn collapse_node(bin: &[Node], i: usize, out: &mut Vec<Node4>) -> u32 {
+    let mut kids = [0usize; 4];
+    kids[0] = i + 1;
+    kids[1] = bin[i].offset as usize;
+    let mut n = 2;
+    while n < 4 {
+        // Open the inner child most likely to be visited.
+        let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
+            let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
+            sa.total_cmp(&sb)
+        });
+        let Some(k) = best else { break };
+        let open = kids[k];
+        kids[k] = open + 1;
+        kids[n] = bin[open].offset as usize;
+        n += 1;
+    }
+    let index = out.len();
+    out.push(Node4::EMPTY);
+    let mut node = Node4::EMPTY;
+    for (lane, &c) in kids[..n].iter().enumerate() {
+        let b = &bin[c];
+        for a in 0..3 {
+            node.min[a][lane] = b.min[a];
+            node.max[a][lane] = b.max[a];
+        }
+        if b.is_leaf() {
+            node.child[lane] = b.offset;
+            node.count[lane] = b.count as u32;
+        } else {
+            node.child[lane] = collapse_node(bin, c, out);
+        }
+    }
+    out[index] = node;
+    index as u32
+}

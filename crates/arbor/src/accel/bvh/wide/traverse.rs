@@ -1,0 +1,336 @@
+//! Traversal of the 4-wide tree: one ray against four boxes at once, nearest child first.
+//!
+//! Hand-written SSE (`std::arch`, baseline on x86_64; a scalar version elsewhere) because this loop is
+//! the hot core of every query: the four slab tests share the ray's broadcast origin and reciprocal
+//! direction, and the per-axis choice of the entry plane is precomputed as load offsets, so a node test
+//! is about 20 instructions without branches. The stack lives in uninitialised memory so that a query
+//! does not pay for clearing it.
+//!
+//! Exactness against brute force follows the binary traversal (`../traverse.rs`), whose argument holds
+//! lane by lane: the box test is the same conservative test, `near <= far + scale * SLACK` with `scale`
+//! the larger slab distance on the ray's major axis; `max`/`min` take the accumulator as the operand
+//! that wins over a NaN, as `f32::max`/`min` do; a node at exactly the best `t` is still visited; leaves
+//! ask for hits up to the float above the best `t` and keep ties by lowest primitive index.
+//! Children are pushed farthest first with their entry distance and slack; a popped entry is skipped
+//! when `near > t_far + slack`, which is implied by failing its box test against the current `t_far`
+//! (float addition is monotone), so the skip never drops a box that test would keep.
+
+use std::mem::MaybeUninit;
+
+use super::super::traverse::next_up;
+use super::super::MAX_DEPTH;
+use super::{Node4, Ref, Wide};
+use crate::accel::{Hit, PrimHit, Primitives, TraversalCounts, BOX_SLACK};
+use crate::geometry::{intersect_triangle_in, RayFrame};
+use crate::math::Ray;
+
+/// At most three entries are pushed per level of the current path.
+const STACK: usize = 3 * MAX_DEPTH + 1;
+
+#[derive(Clone, Copy)]
+struct Entry {
+    r: Ref,
+    near: f32,
+    slack: f32,
+}
+
+/// A ray prepared for four-box tests: per axis, where the entry and exit planes are in a node (as `f32`
+/// offsets into it), the broadcast origin and reciprocal direction.
+struct Lanes {
+    enter: [usize; 3],
+    exit: [usize; 3],
+    org: [f32; 3],
+    inv: [f32; 3],
+    major: usize,
+}
+
+impl Lanes {
+    fn new(ray: &Ray) -> Self {
+        let inv = ray.inv_dir.to_array();
+        let d = ray.dir.abs();
+        let major = if d.x > d.y && d.x > d.z {
+            0
+        } else if d.y > d.z {
+            1
+        } else {
+            2
+        };
+        // `min` is at f32 offset 4a, `max` at 12 + 4a (`Node4` is `repr(C)`).
+        let neg = |a: usize| inv[a].is_sign_negative();
+        Lanes {
+            enter: std::array::from_fn(|a| if neg(a) { 12 + 4 * a } else { 4 * a }),
+            exit: std::array::from_fn(|a| if neg(a) { 4 * a } else { 12 + 4 * a }),
+            org: ray.origin.to_array(),
+            inv,
+            major,
+        }
+    }
+
+    /// The lanes whose box the ray meets in `[0, t_far]` (bit per lane), their entry distances and
+    /// their slacks.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn test(&self, node: &Node4, t_far: f32) -> (u32, [f32; 4], [f32; 4]) {
+        use std::arch::x86_64::*;
+        let base = (node as *const Node4).cast::<f32>();
+        let mut near_out = [0.0f32; 4];
+        let mut slack_out = [0.0f32; 4];
+        // SAFETY: SSE2 is part of the x86_64 baseline; every offset is below 24 floats, inside the
+        // 128-byte node, and a multiple of 4 floats from its 64-byte aligned start, as `_mm_load_ps`
+        // requires; the stores go to local arrays of four floats.
+        let mask = unsafe {
+            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+            let mut near = _mm_setzero_ps();
+            let mut far = _mm_set1_ps(t_far);
+            let mut scale = _mm_setzero_ps();
+            for a in 0..3 {
+                let o = _mm_set1_ps(self.org[a]);
+                let inv = _mm_set1_ps(self.inv[a]);
+                let t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.enter[a])), o), inv);
+                let t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.exit[a])), o), inv);
+                // The second operand is returned when either is NaN: the accumulator wins, as in
+                // `f32::max`.
+                near = _mm_max_ps(t0, near);
+                far = _mm_min_ps(t1, far);
+                if a == self.major {
+                    scale = _mm_max_ps(_mm_and_ps(t0, abs), scale);
+                    scale = _mm_max_ps(_mm_and_ps(t1, abs), scale);
+                }
+            }
+            let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
+            _mm_storeu_ps(near_out.as_mut_ptr(), near);
+            _mm_storeu_ps(slack_out.as_mut_ptr(), slack);
+            _mm_movemask_ps(_mm_cmple_ps(near, _mm_add_ps(far, slack))) as u32
+        };
+        (mask, near_out, slack_out)
+    }
+
+    /// The scalar form of the four-box test, for targets without SSE.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    fn test(&self, node: &Node4, t_far: f32) -> (u32, [f32; 4], [f32; 4]) {
+        let flat: &[f32; 32] = bytemuck_free_view(node);
+        let mut near_out = [0.0f32; 4];
+        let mut slack_out = [0.0f32; 4];
+        let mut mask = 0;
+        for lane in 0..4 {
+            let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
+            for a in 0..3 {
+                let t0 = (flat[self.enter[a] + lane] - self.org[a]) * self.inv[a];
+                let t1 = (flat[self.exit[a] + lane] - self.org[a]) * self.inv[a];
+                near = near.max(t0);
+                far = far.min(t1);
+                if a == self.major {
+                    scale = scale.max(t0.abs()).max(t1.abs());
+                }
+            }
+            let slack = scale * BOX_SLACK;
+            near_out[lane] = near;
+            slack_out[lane] = slack;
+            mask |= ((near <= far + slack) as u32) << lane;
+        }
+        (mask, near_out, slack_out)
+    }
+}
+
+/// The node's floats: boxes first, then the child words reinterpreted (never read as floats).
+#[cfg(not(target_arch = "x86_64"))]
+fn bytemuck_free_view(node: &Node4) -> &[f32; 32] {
+    // SAFETY: `Node4` is `repr(C)`, 128 bytes of 4-byte fields, aligned to 64.
+    unsafe { &*(node as *const Node4).cast::<[f32; 32]>() }
+}
+
+/// Asks the cache for the node `r` refers to (its box lanes span the node's first 96 bytes), so that a
+/// child pushed now is in cache when popped: node fetches are most of a query's stalls.
+#[inline(always)]
+fn prefetch(wide: &Wide, r: Ref) {
+    #[cfg(target_arch = "x86_64")]
+    if r.count == 0 {
+        if let Some(node) = wide.nodes.get(r.child as usize) {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let p = (node as *const Node4).cast::<i8>();
+            // SAFETY: a prefetch never faults; both addresses are inside the node.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.add(64));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (wide, r);
+}
+
+/// True when no query can hit anything: invalid ray or an empty `(0, t_max)`.
+#[inline]
+fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
+    !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
+}
+
+/// The closest hit in `(0, t_max)`, ties to the lowest primitive index; with `COUNT`, the wide nodes
+/// visited and primitives tested are added to `counts`.
+pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    let mut cur = wide.root?;
+    if trivially_misses(ray, t_max) {
+        return None;
+    }
+    let lanes = Lanes::new(ray);
+    let frame = RayFrame::new(ray);
+    let mut best: Option<Hit> = None;
+    // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
+    let mut t_far = t_max;
+    let mut t_query = t_max;
+    let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
+    let mut sp = 0usize;
+    loop {
+        if cur.count == 0 {
+            let node = &wide.nodes[cur.child as usize];
+            if COUNT {
+                counts.nodes += 1;
+            }
+            let (mask, near, slack) = lanes.test(node, t_far);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                if mask & (mask - 1) == 0 {
+                    cur = Ref { child: node.child[first], count: node.count[first] };
+                    continue;
+                }
+                // Two to four children: push them all, sort the pushed entries so that the nearest is on
+                // top (farthest deepest), and continue with the nearest.
+                let base = sp;
+                let mut m = mask;
+                while m != 0 {
+                    let l = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let e =
+                        Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
+                    // Insertion by decreasing `near`: at most three moves.
+                    let mut j = sp;
+                    // SAFETY: `base..sp` were written in this loop.
+                    while j > base && unsafe { stack[j - 1].assume_init_ref() }.near < e.near {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = MaybeUninit::new(e);
+                    sp += 1;
+                    prefetch(wide, e.r);
+                }
+                sp -= 1;
+                // SAFETY: written just above.
+                cur = unsafe { stack[sp].assume_init() }.r;
+                continue;
+            }
+        } else {
+            let first = cur.child as usize;
+            let range = first..first + cur.count as usize;
+            match &wide.tris {
+                Some(tris) => {
+                    for (k, [a, b, c]) in range.clone().zip(&tris[range]) {
+                        if COUNT {
+                            counts.prims += 1;
+                        }
+                        if let Some(h) = intersect_triangle_in(&frame, *a, *b, *c, t_query) {
+                            let hit = Hit::new(indices[k], PrimHit::new(h.t, h.b1, h.b2));
+                            if hit.beats(&best) {
+                                t_far = hit.t;
+                                t_query = next_up(hit.t);
+                                best = Some(hit);
+                            }
+                        }
+                    }
+                }
+                None => {
+                    for &prim in &indices[range] {
+                        let h = if COUNT {
+                            prims.intersect_counted(prim as usize, ray, t_query, counts)
+                        } else {
+                            prims.intersect(prim as usize, ray, t_query)
+                        };
+                        if let Some(h) = h {
+                            let hit = Hit::new(prim, h);
+                            if hit.beats(&best) {
+                                t_far = hit.t;
+                                t_query = next_up(hit.t);
+                                best = Some(hit);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        loop {
+            if sp == 0 {
+                return best;
+            }
+            sp -= 1;
+            // SAFETY: entries below `sp` were written by the pushes above.
+            let e = unsafe { stack[sp].assume_init() };
+            // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if !(e.near > t_far + e.slack) {
+                cur = e.r;
+                break;
+            }
+        }
+    }
+}
+
+/// Whether anything is hit in `(0, t_max)`; stops at the first hit, visits children in any order.
+pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+) -> bool {
+    let Some(mut cur) = wide.root else { return false };
+    if trivially_misses(ray, t_max) {
+        return false;
+    }
+    let lanes = Lanes::new(ray);
+    let frame = RayFrame::new(ray);
+    let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
+    let mut sp = 0usize;
+    loop {
+        if cur.count == 0 {
+            let node = &wide.nodes[cur.child as usize];
+            let (mut mask, _, _) = lanes.test(node, t_max);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                while mask != 0 {
+                    let l = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[sp] = MaybeUninit::new(Ref { child: node.child[l], count: node.count[l] });
+                    sp += 1;
+                }
+                cur = Ref { child: node.child[first], count: node.count[first] };
+                continue;
+            }
+        } else {
+            let first = cur.child as usize;
+            let range = first..first + cur.count as usize;
+            let hit = match &wide.tris {
+                Some(tris) => {
+                    tris[range].iter().any(|[a, b, c]| intersect_triangle_in(&frame, *a, *b, *c, t_max).is_some())
+                }
+                None => indices[range].iter().any(|&p| prims.occludes(p as usize, ray, t_max)),
+            };
+            if hit {
+                return true;
+            }
+        }
+        if sp == 0 {
+            return false;
+        }
+        sp -= 1;
+        // SAFETY: entries below `sp` were written by the pushes above.
+        cur = unsafe { stack[sp].assume_init() };
+    }
+}
