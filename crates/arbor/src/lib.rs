@@ -25,5 +25,7 @@ pub mod mesh_io;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+#[cfg(test)]
+mod test_rng;
 
 pub use error::{Error, Location, Result};

@@ -230,19 +230,7 @@ mod tests {
         assert!(got.contains(&Aabb::new(Vec3::new(0.0, 0.5, 0.5), Vec3::new(1.0, 0.5, 0.5))));
     }
 
-    /// xorshift64*.
-    struct Rng(u64);
-    impl Rng {
-        fn f32(&mut self) -> f32 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn vec3(&mut self) -> Vec3 {
-            Vec3::new(self.f32(), self.f32(), self.f32())
-        }
-    }
+    use crate::test_rng::Rng;
 
     #[test]
     fn triangle_clip_contains_every_inside_point_and_stays_within_bounds() {

@@ -5,20 +5,7 @@ use super::*;
 use crate::accel::{build, AccelKind, BruteForce};
 use crate::geometry::TriangleMesh;
 
-/// xorshift64*: small, seeded, good enough to scatter triangles.
-pub(super) struct Rng(pub u64);
-
-impl Rng {
-    pub(super) fn f32(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    pub(super) fn vec3(&mut self) -> Vec3 {
-        Vec3::new(self.f32(), self.f32(), self.f32())
-    }
-}
+pub(super) use crate::test_rng::Rng;
 
 pub(super) fn soup(n: usize, seed: u64) -> TriangleMesh {
     let mut rng = Rng(seed);

@@ -6,20 +6,7 @@ use crate::accel::{AccelKind, AccelSpec, BruteForce};
 use crate::geometry::TriangleMesh;
 use crate::math::Vec3;
 
-/// xorshift64*: small, seeded, good enough to scatter triangles.
-struct Rng(u64);
-
-impl Rng {
-    fn f32(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn vec3(&mut self) -> Vec3 {
-        Vec3::new(self.f32(), self.f32(), self.f32())
-    }
-}
+use crate::test_rng::Rng;
 
 fn mesh_of(tris: &[[Vec3; 3]]) -> TriangleMesh {
     TriangleMesh {
