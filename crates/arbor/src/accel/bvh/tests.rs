@@ -133,17 +133,23 @@ fn bvh_flat_and_degenerate_triangles_are_handled() {
     assert_matches_brute(&mesh, &bvh, &rays(2000, 8));
 }
 
-#[test]
-fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
-    // Each binned split peels off only the few largest centroids: without the depth limit the tree
-    // would be hundreds of levels deep.
+/// `n` parallel triangles at x = 0.93^i: each binned split can peel off only the few largest.
+fn exponentially_spaced(n: i32) -> TriangleMesh {
     let mut mesh = TriangleMesh::default();
-    for i in 0..2000 {
+    for i in 0..n {
         let x = 0.93f32.powi(i);
         let k = mesh.positions.len() as u32;
         mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
         mesh.indices.push([k, k + 1, k + 2]);
     }
+    mesh
+}
+
+#[test]
+fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
+    // Each binned split peels off only the few largest centroids: without the depth limit the tree
+    // would be hundreds of levels deep.
+    let mesh = exponentially_spaced(2000);
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
     bvh.validate(&mesh).unwrap();
     let stats = Accel::<TriangleMesh>::stats(&bvh);
@@ -285,13 +291,7 @@ fn median_build_is_identical_for_any_thread_count() {
 
 #[test]
 fn median_depth_is_logarithmic_on_exponentially_spaced_centroids() {
-    let mut mesh = TriangleMesh::default();
-    for i in 0..2000 {
-        let x = 0.93f32.powi(i);
-        let k = mesh.positions.len() as u32;
-        mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
-        mesh.indices.push([k, k + 1, k + 2]);
-    }
+    let mesh = exponentially_spaced(2000);
     let bvh = Bvh::build_median(&mesh, &MedianParams::default());
     bvh.validate(&mesh).unwrap();
     assert!(Accel::<TriangleMesh>::stats(&bvh).max_depth <= 11);
