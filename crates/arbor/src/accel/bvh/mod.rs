@@ -35,7 +35,7 @@ mod wide;
 use std::time::{Duration, Instant};
 
 pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
-pub use wide::{Node4, Wide};
+pub use wide::{Node8, Wide};
 
 use super::params::{parse_value, unknown_key};
 use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};

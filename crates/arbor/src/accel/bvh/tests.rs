@@ -202,8 +202,8 @@ fn bvh_stats_describe_the_tree() {
     assert_eq!(s.nodes, 2 * s.leaves - 1);
     assert!(s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0, "{s:?}");
     assert!(s.sah_cost > 1.0 && s.sah_cost < 10_000.0, "{s:?}");
-    // Binary nodes and indices, the 4-wide nodes, and the triangles' corners in leaf order.
-    let wide = 128 * bvh.wide.nodes().len() + 36 * 10_000;
+    // Binary nodes and indices, the 8-wide nodes, and the triangles' corners in leaf order.
+    let wide = 256 * bvh.wide.nodes().len() + 36 * 10_000;
     assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000 + wide);
 }
 
@@ -336,5 +336,30 @@ fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() 
         let occ = traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, &ray, 4.0);
         assert_eq!(with_copy.occluded(&mesh, &ray, 4.0), occ);
         assert_eq!(without.occluded(&opaque, &ray, 4.0), occ);
+    }
+}
+
+#[test]
+fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
+    use super::wide::{intersect_with, Kernel};
+    let mesh = soup(5000, 29);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let mut kernels = vec![Kernel::Scalar];
+    if cfg!(target_arch = "x86_64") {
+        kernels.push(Kernel::Sse);
+    }
+    if Kernel::detect() == Kernel::Avx2 {
+        kernels.push(Kernel::Avx2);
+    }
+    for ray in rays(3000, 8) {
+        let run = |k: Kernel| {
+            let mut c = TraversalCounts::default();
+            let hit = intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c);
+            (hit, c.nodes, c.prims)
+        };
+        let scalar = run(Kernel::Scalar);
+        for &k in &kernels[1..] {
+            assert_eq!(run(k), scalar, "{k:?} {ray:?}");
+        }
     }
 }

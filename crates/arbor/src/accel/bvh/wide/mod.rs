@@ -1,10 +1,12 @@
-//! The 4-wide form of a binary BVH, which is what queries traverse (Wald, Benthin and Boulos 2008,
-//! "Getting rid of packets"; Embree's BVH4): every binary tree, whatever its builder, is collapsed
-//! into nodes of up to four children whose boxes are stored as structure-of-arrays `f32` lanes, so
-//! one ray is tested against four boxes at once (`traverse.rs`, SSE).
+//! The 8-wide form of a binary BVH, which is what queries traverse (Wald, Benthin and Boulos 2008,
+//! "Getting rid of packets"; Embree's BVH8): every binary tree, whatever its builder, is collapsed
+//! into nodes of up to eight children whose boxes are stored as structure-of-arrays `f32` lanes, so
+//! one ray is tested against eight boxes at once (`traverse.rs`: AVX2 when the processor has it,
+//! else two SSE halves). Eight children rather than four: a query visits about half as many nodes, and
+//! node fetches are where incoherent rays spend their time.
 //!
 //! Collapse: starting from a binary node's two children, the inner child with the largest surface area
-//! is repeatedly replaced by its own two children until there are four, or only leaves (the SAH
+//! is repeatedly replaced by its own two children until there are eight, or only leaves (the SAH
 //! probability of being visited decides which level to skip). Leaves keep their ranges of the binary
 //! tree's primitive order.
 //!
@@ -14,37 +16,46 @@
 //! test on the same corner values, so hits are bit for bit those of brute force. Other primitives are
 //! asked through [`Primitives::intersect`].
 //!
-//! Cost: 128 bytes per node (about `n / (2.5 * leaf size)` nodes), 36 bytes per triangle; the collapse
+//! Cost: 256 bytes per node (about `n / (5 * leaf size)` nodes), 36 bytes per triangle; the collapse
 //! is linear in the binary tree's size.
 
 mod traverse;
 
 pub(super) use traverse::{intersect, occluded};
+#[cfg(test)]
+pub(super) use traverse::{intersect_with, Kernel};
 
 use super::Node;
 use crate::accel::Primitives;
 use crate::math::Vec3;
 
-/// One 4-wide node: boxes of up to four children as lanes (`[axis][lane]`), and what each child is.
+/// Children per wide node.
+pub const WIDTH: usize = 8;
+
+/// One 8-wide node: boxes of up to eight children as lanes (`[axis][lane]`), and what each child is.
 /// Unused lanes have an inverted infinite box (min `+inf`, max `-inf`), which every ray misses.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
-pub struct Node4 {
+pub struct Node8 {
     /// Lower corners, per axis then lane.
-    pub min: [[f32; 4]; 3],
+    pub min: [[f32; WIDTH]; 3],
     /// Upper corners, per axis then lane.
-    pub max: [[f32; 4]; 3],
+    pub max: [[f32; WIDTH]; 3],
     /// Per lane: the child node's index (inner child), or its first primitive in leaf order (leaf).
-    pub child: [u32; 4],
+    pub child: [u32; WIDTH],
     /// Per lane: 0 for an inner child (or an unused lane), else the leaf's primitive count.
-    pub count: [u32; 4],
+    pub count: [u32; WIDTH],
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+const _: () = assert!(std::mem::size_of::<Node8>() == 256);
 
-impl Node4 {
-    const EMPTY: Node4 =
-        Node4 { min: [[f32::INFINITY; 4]; 3], max: [[f32::NEG_INFINITY; 4]; 3], child: [u32::MAX; 4], count: [0; 4] };
+impl Node8 {
+    const EMPTY: Node8 = Node8 {
+        min: [[f32::INFINITY; WIDTH]; 3],
+        max: [[f32::NEG_INFINITY; WIDTH]; 3],
+        child: [u32::MAX; WIDTH],
+        count: [0; WIDTH],
+    };
 }
 
 /// A reference to a subtree: an inner node (`count == 0`) or a leaf.
@@ -54,10 +65,10 @@ pub(super) struct Ref {
     pub count: u32,
 }
 
-/// The 4-wide tree and, for triangle meshes, the triangles in leaf order.
+/// The 8-wide tree and, for triangle meshes, the triangles in leaf order.
 #[derive(Debug, Clone, Default)]
 pub struct Wide {
-    nodes: Vec<Node4>,
+    nodes: Vec<Node8>,
     /// The root: node 0, or a single leaf; `None` for an empty tree.
     root: Option<Ref>,
     tris: Option<Vec<[Vec3; 3]>>,
@@ -82,23 +93,23 @@ impl Wide {
 
     /// Bytes of the wide nodes and the triangle copy.
     pub fn bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<Node4>()
+        self.nodes.len() * std::mem::size_of::<Node8>()
             + self.tris.as_ref().map_or(0, |t| t.len() * std::mem::size_of::<[Vec3; 3]>())
     }
 
     /// The wide nodes (node 0 is the root when the root is not a leaf).
-    pub fn nodes(&self) -> &[Node4] {
+    pub fn nodes(&self) -> &[Node8] {
         &self.nodes
     }
 }
 
 /// Writes the wide node for binary inner node `i` and its subtree; returns its index.
-fn collapse_node(bin: &[Node], i: usize, out: &mut Vec<Node4>) -> u32 {
-    let mut kids = [0usize; 4];
+fn collapse_node(bin: &[Node], i: usize, out: &mut Vec<Node8>) -> u32 {
+    let mut kids = [0usize; WIDTH];
     kids[0] = i + 1;
     kids[1] = bin[i].offset as usize;
     let mut n = 2;
-    while n < 4 {
+    while n < WIDTH {
         // Open the inner child most likely to be visited.
         let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
             let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
@@ -111,8 +122,8 @@ fn collapse_node(bin: &[Node], i: usize, out: &mut Vec<Node4>) -> u32 {
         n += 1;
     }
     let index = out.len();
-    out.push(Node4::EMPTY);
-    let mut node = Node4::EMPTY;
+    out.push(Node8::EMPTY);
+    let mut node = Node8::EMPTY;
     for (lane, &c) in kids[..n].iter().enumerate() {
         let b = &bin[c];
         for a in 0..3 {

@@ -1,10 +1,12 @@
-//! Traversal of the 4-wide tree: one ray against four boxes at once, nearest child first.
+//! Traversal of the 8-wide tree: one ray against eight boxes at once, nearest child first.
 //!
-//! Hand-written SSE (`std::arch`, baseline on x86_64; a scalar version elsewhere) because this loop is
-//! the hot core of every query: the four slab tests share the ray's broadcast origin and reciprocal
-//! direction, and the per-axis choice of the entry plane is precomputed as load offsets, so a node test
-//! is about 20 instructions without branches. The stack lives in uninitialised memory so that a query
-//! does not pay for clearing it.
+//! Hand-written SIMD (`std::arch`) because this loop is the hot core of every query: the eight slab
+//! tests share the ray's broadcast origin and reciprocal direction, and the per-axis choice of the entry
+//! plane is precomputed as load offsets, so a node test is about 20 instructions without branches. With
+//! AVX2 (detected at run time, once per query) the eight lanes are one register and the whole query is
+//! compiled for AVX2; without it, two SSE halves (SSE2 is the x86_64 baseline); elsewhere, scalar code.
+//! All three compute the same per-lane arithmetic, so they visit the same nodes (unit test). The stack
+//! lives in uninitialised memory so that a query does not pay for clearing it.
 //!
 //! Exactness against brute force follows the binary traversal (`../traverse.rs`), whose argument holds
 //! lane by lane: the box test is the same conservative test, `near <= far + scale * SLACK` with `scale`
@@ -19,13 +21,46 @@ use std::mem::MaybeUninit;
 
 use super::super::traverse::next_up;
 use super::super::MAX_DEPTH;
-use super::{Node4, Ref, Wide};
+use super::{Node8, Ref, Wide, WIDTH};
 use crate::accel::{Hit, PrimHit, Primitives, TraversalCounts, BOX_SLACK};
 use crate::geometry::{intersect_triangle_in, RayFrame};
 use crate::math::Ray;
 
-/// At most three entries are pushed per level of the current path.
-const STACK: usize = 3 * MAX_DEPTH + 1;
+/// At most `WIDTH - 1` entries are pushed per level of the current path.
+const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
+
+/// The code that tests a node's boxes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kernel {
+    /// One 8-lane AVX2 register per axis and side.
+    Avx2,
+    /// Two 4-lane SSE halves.
+    Sse,
+    /// A loop over the lanes.
+    Scalar,
+}
+
+impl Kernel {
+    /// The fastest kernel this processor runs.
+    #[inline]
+    pub fn detect() -> Kernel {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") {
+                Kernel::Avx2
+            } else {
+                Kernel::Sse
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        Kernel::Scalar
+    }
+}
+
+/// `Kernel` as a const generic parameter.
+const AVX2: u8 = 0;
+const SSE: u8 = 1;
+const SCALAR: u8 = 2;
 
 #[derive(Clone, Copy)]
 struct Entry {
@@ -34,7 +69,11 @@ struct Entry {
     slack: f32,
 }
 
-/// A ray prepared for four-box tests: per axis, where the entry and exit planes are in a node (as `f32`
+/// What a node test returns: the lanes whose box the ray meets in `[0, t_far]` (bit per lane), their
+/// entry distances and their slacks.
+type Tested = (u32, [f32; WIDTH], [f32; WIDTH]);
+
+/// A ray prepared for eight-box tests: per axis, where the entry and exit planes are in a node (as `f32`
 /// offsets into it), the broadcast origin and reciprocal direction.
 struct Lanes {
     enter: [usize; 3],
@@ -55,65 +94,117 @@ impl Lanes {
         } else {
             2
         };
-        // `min` is at f32 offset 4a, `max` at 12 + 4a (`Node4` is `repr(C)`).
+        // `min` is at f32 offset 8a, `max` at 24 + 8a (`Node8` is `repr(C)`).
         let neg = |a: usize| inv[a].is_sign_negative();
+        let w = WIDTH;
         Lanes {
-            enter: std::array::from_fn(|a| if neg(a) { 12 + 4 * a } else { 4 * a }),
-            exit: std::array::from_fn(|a| if neg(a) { 4 * a } else { 12 + 4 * a }),
+            enter: std::array::from_fn(|a| if neg(a) { 3 * w + w * a } else { w * a }),
+            exit: std::array::from_fn(|a| if neg(a) { w * a } else { 3 * w + w * a }),
             org: ray.origin.to_array(),
             inv,
             major,
         }
     }
 
-    /// The lanes whose box the ray meets in `[0, t_far]` (bit per lane), their entry distances and
-    /// their slacks.
-    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn test(&self, node: &Node4, t_far: f32) -> (u32, [f32; 4], [f32; 4]) {
-        use std::arch::x86_64::*;
-        let base = (node as *const Node4).cast::<f32>();
-        let mut near_out = [0.0f32; 4];
-        let mut slack_out = [0.0f32; 4];
-        // SAFETY: SSE2 is part of the x86_64 baseline; every offset is below 24 floats, inside the
-        // 128-byte node, and a multiple of 4 floats from its 64-byte aligned start, as `_mm_load_ps`
-        // requires; the stores go to local arrays of four floats.
-        let mask = unsafe {
-            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
-            let mut near = _mm_setzero_ps();
-            let mut far = _mm_set1_ps(t_far);
-            let mut scale = _mm_setzero_ps();
-            for a in 0..3 {
-                let o = _mm_set1_ps(self.org[a]);
-                let inv = _mm_set1_ps(self.inv[a]);
-                let t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.enter[a])), o), inv);
-                let t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.exit[a])), o), inv);
-                // The second operand is returned when either is NaN: the accumulator wins, as in
-                // `f32::max`.
-                near = _mm_max_ps(t0, near);
-                far = _mm_min_ps(t1, far);
-                if a == self.major {
-                    scale = _mm_max_ps(_mm_and_ps(t0, abs), scale);
-                    scale = _mm_max_ps(_mm_and_ps(t1, abs), scale);
-                }
+    fn test<const K: u8>(&self, node: &Node8, t_far: f32) -> Tested {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if K == AVX2 {
+                // SAFETY: `AVX2` is only instantiated inside `intersect_avx2`/`occluded_avx2`, which are
+                // called only when the processor has AVX2.
+                return unsafe { self.test_avx2(node, t_far) };
             }
-            let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
-            _mm_storeu_ps(near_out.as_mut_ptr(), near);
-            _mm_storeu_ps(slack_out.as_mut_ptr(), slack);
-            _mm_movemask_ps(_mm_cmple_ps(near, _mm_add_ps(far, slack))) as u32
-        };
+            if K == SSE {
+                return self.test_sse(node, t_far);
+            }
+        }
+        self.test_scalar(node, t_far)
+    }
+
+    /// The eight lanes in one AVX register per row.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn test_avx2(&self, node: &Node8, t_far: f32) -> Tested {
+        use std::arch::x86_64::*;
+        let base = (node as *const Node8).cast::<f32>();
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
+        // Every offset is below 48 floats, inside the 256-byte node, and a multiple of 8 floats from
+        // its 64-byte aligned start, as `_mm256_load_ps` requires; the stores go to local arrays.
+        let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+        let mut near = _mm256_setzero_ps();
+        let mut far = _mm256_set1_ps(t_far);
+        let mut scale = _mm256_setzero_ps();
+        for a in 0..3 {
+            let o = _mm256_set1_ps(self.org[a]);
+            let inv = _mm256_set1_ps(self.inv[a]);
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.enter[a])), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.exit[a])), o), inv);
+            // The second operand is returned when either is NaN: the accumulator wins, as in
+            // `f32::max`.
+            near = _mm256_max_ps(t0, near);
+            far = _mm256_min_ps(t1, far);
+            if a == self.major {
+                scale = _mm256_max_ps(_mm256_and_ps(t0, abs), scale);
+                scale = _mm256_max_ps(_mm256_and_ps(t1, abs), scale);
+            }
+        }
+        let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
+        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack))) as u32;
         (mask, near_out, slack_out)
     }
 
-    /// The scalar form of the four-box test, for targets without SSE.
-    #[cfg(not(target_arch = "x86_64"))]
+    /// The eight lanes as two SSE halves.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn test(&self, node: &Node4, t_far: f32) -> (u32, [f32; 4], [f32; 4]) {
-        let flat: &[f32; 32] = bytemuck_free_view(node);
-        let mut near_out = [0.0f32; 4];
-        let mut slack_out = [0.0f32; 4];
+    fn test_sse(&self, node: &Node8, t_far: f32) -> Tested {
+        use std::arch::x86_64::*;
+        let base = (node as *const Node8).cast::<f32>();
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
         let mut mask = 0;
-        for lane in 0..4 {
+        // SAFETY: SSE2 is part of the x86_64 baseline; every offset is below 48 floats, inside the
+        // 256-byte node, and a multiple of 4 floats from its 64-byte aligned start, as `_mm_load_ps`
+        // requires; the stores go to local arrays of eight floats at offsets 0 and 4.
+        unsafe {
+            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+            for half in [0, 4] {
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_far);
+                let mut scale = _mm_setzero_ps();
+                for a in 0..3 {
+                    let o = _mm_set1_ps(self.org[a]);
+                    let inv = _mm_set1_ps(self.inv[a]);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.enter[a] + half)), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.exit[a] + half)), o), inv);
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                    if a == self.major {
+                        scale = _mm_max_ps(_mm_and_ps(t0, abs), scale);
+                        scale = _mm_max_ps(_mm_and_ps(t1, abs), scale);
+                    }
+                }
+                let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
+                _mm_storeu_ps(near_out.as_mut_ptr().add(half), near);
+                _mm_storeu_ps(slack_out.as_mut_ptr().add(half), slack);
+                mask |= (_mm_movemask_ps(_mm_cmple_ps(near, _mm_add_ps(far, slack))) as u32) << half;
+            }
+        }
+        (mask, near_out, slack_out)
+    }
+
+    /// The same test one lane at a time.
+    #[inline(always)]
+    fn test_scalar(&self, node: &Node8, t_far: f32) -> Tested {
+        let flat: &[f32; 64] = float_view(node);
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
+        let mut mask = 0;
+        for lane in 0..WIDTH {
             let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
             for a in 0..3 {
                 let t0 = (flat[self.enter[a] + lane] - self.org[a]) * self.inv[a];
@@ -134,25 +225,27 @@ impl Lanes {
 }
 
 /// The node's floats: boxes first, then the child words reinterpreted (never read as floats).
-#[cfg(not(target_arch = "x86_64"))]
-fn bytemuck_free_view(node: &Node4) -> &[f32; 32] {
-    // SAFETY: `Node4` is `repr(C)`, 128 bytes of 4-byte fields, aligned to 64.
-    unsafe { &*(node as *const Node4).cast::<[f32; 32]>() }
+#[inline(always)]
+fn float_view(node: &Node8) -> &[f32; 64] {
+    // SAFETY: `Node8` is `repr(C)`, 256 bytes of 4-byte fields, aligned to 64.
+    unsafe { &*(node as *const Node8).cast::<[f32; 64]>() }
 }
 
-/// Asks the cache for the node `r` refers to (its box lanes span the node's first 96 bytes), so that a
-/// child pushed now is in cache when popped: node fetches are most of a query's stalls.
+/// Asks the cache for the node `r` refers to (its four cache lines), so that a child pushed now is in
+/// cache when popped: node fetches are most of a query's stalls.
 #[inline(always)]
 fn prefetch(wide: &Wide, r: Ref) {
     #[cfg(target_arch = "x86_64")]
     if r.count == 0 {
         if let Some(node) = wide.nodes.get(r.child as usize) {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let p = (node as *const Node4).cast::<i8>();
-            // SAFETY: a prefetch never faults; both addresses are inside the node.
+            let p = (node as *const Node8).cast::<i8>();
+            // SAFETY: a prefetch never faults; every address is inside the node.
             unsafe {
                 _mm_prefetch::<_MM_HINT_T0>(p);
                 _mm_prefetch::<_MM_HINT_T0>(p.add(64));
+                _mm_prefetch::<_MM_HINT_T0>(p.add(128));
+                _mm_prefetch::<_MM_HINT_T0>(p.add(192));
             }
         }
     }
@@ -168,7 +261,59 @@ fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
 
 /// The closest hit in `(0, t_max)`, ties to the lowest primitive index; with `COUNT`, the wide nodes
 /// visited and primitives tested are added to `counts`.
+#[inline]
 pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    intersect_with::<P, COUNT>(Kernel::detect(), wide, indices, prims, ray, t_max, counts)
+}
+
+/// [`intersect`] with the given kernel, which the processor must support.
+#[inline]
+pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx2 => {
+            assert!(std::is_x86_feature_detected!("avx2"));
+            // SAFETY: the processor has AVX2 (checked just above; the check is a cached load).
+            unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) }
+        }
+        Kernel::Sse if cfg!(target_arch = "x86_64") => {
+            intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
+        }
+        _ => intersect_kernel::<P, COUNT, SCALAR>(wide, indices, prims, ray, t_max, counts),
+    }
+}
+
+/// The whole query compiled for AVX2, so that the node test inlines.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn intersect_avx2<P: Primitives + ?Sized, const COUNT: bool>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    intersect_kernel::<P, COUNT, AVX2>(wide, indices, prims, ray, t_max, counts)
+}
+
+#[inline(always)]
+fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
     wide: &Wide,
     indices: &[u32],
     prims: &P,
@@ -194,14 +339,14 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
             if COUNT {
                 counts.nodes += 1;
             }
-            let (mask, near, slack) = lanes.test(node, t_far);
+            let (mask, near, slack) = lanes.test::<K>(node, t_far);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 if mask & (mask - 1) == 0 {
                     cur = Ref { child: node.child[first], count: node.count[first] };
                     continue;
                 }
-                // Two to four children: push them all, sort the pushed entries so that the nearest is on
+                // Two to eight children: push them all, sort the pushed entries so that the nearest is on
                 // top (farthest deepest), and continue with the nearest.
                 let base = sp;
                 let mut m = mask;
@@ -210,7 +355,7 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
                     m &= m - 1;
                     let e =
                         Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
-                    // Insertion by decreasing `near`: at most three moves.
+                    // Insertion by decreasing `near`.
                     let mut j = sp;
                     // SAFETY: `base..sp` were written in this loop.
                     while j > base && unsafe { stack[j - 1].assume_init_ref() }.near < e.near {
@@ -282,7 +427,37 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
 }
 
 /// Whether anything is hit in `(0, t_max)`; stops at the first hit, visits children in any order.
+#[inline]
 pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+) -> bool {
+    match Kernel::detect() {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `detect` found AVX2.
+        Kernel::Avx2 => unsafe { occluded_avx2(wide, indices, prims, ray, t_max) },
+        Kernel::Sse if cfg!(target_arch = "x86_64") => occluded_kernel::<P, SSE>(wide, indices, prims, ray, t_max),
+        _ => occluded_kernel::<P, SCALAR>(wide, indices, prims, ray, t_max),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn occluded_avx2<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+) -> bool {
+    occluded_kernel::<P, AVX2>(wide, indices, prims, ray, t_max)
+}
+
+#[inline(always)]
+fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
     wide: &Wide,
     indices: &[u32],
     prims: &P,
@@ -300,7 +475,7 @@ pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
     loop {
         if cur.count == 0 {
             let node = &wide.nodes[cur.child as usize];
-            let (mut mask, _, _) = lanes.test(node, t_max);
+            let (mut mask, _, _) = lanes.test::<K>(node, t_max);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
