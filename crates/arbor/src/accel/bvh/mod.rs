@@ -231,7 +231,7 @@ impl Bvh {
         kind: &'static str,
         start: Instant,
     ) -> Bvh {
-        let wide = Wide::collapse(&nodes, &prim_indices, live, prims);
+        let wide = Wide::collapse(&nodes, &prim_indices, prims);
         // Statistics are computed when asked for (a walk over every node): not part of the build.
         Bvh { nodes, prim_indices, live, wide, kind, build_time: start.elapsed() }
     }

@@ -202,8 +202,8 @@ fn bvh_stats_describe_the_tree() {
     assert_eq!(s.nodes, 2 * s.leaves - 1);
     assert!(s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims <= 8.0, "{s:?}");
     assert!(s.sah_cost > 1.0 && s.sah_cost < 10_000.0, "{s:?}");
-    // Binary nodes and indices, the 8-wide nodes, and the triangles' corners in leaf order.
-    let wide = 256 * bvh.wide.nodes().len() + 36 * 10_000;
+    // Binary nodes and indices, the 8-wide nodes, and the blocks of four triangles.
+    let wide = 256 * bvh.wide.nodes().len() + 160 * bvh.wide.blocks().len();
     assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000 + wide);
 }
 

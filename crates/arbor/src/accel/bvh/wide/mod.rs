@@ -11,12 +11,14 @@
 //! tree's primitive order.
 //!
 //! When the primitives are a triangle mesh ([`Primitives::triangle_mesh`]), the corners of every
-//! triangle are copied in leaf order (`tris[k]` is triangle `prim_indices[k]`), so the leaf loop reads
-//! consecutive memory instead of chasing two indices per triangle; the test is the same watertight
-//! test on the same corner values, so hits are bit for bit those of brute force. Other primitives are
-//! asked through [`Primitives::intersect`].
+//! leaf's triangles are copied, in leaf order, into blocks of four SIMD lanes ([`LeafBlock`]), so the
+//! leaf loop reads consecutive memory instead of chasing two indices per triangle and tests four
+//! triangles at once ([`crate::geometry::intersect_triangles4`]); that test gives, lane by lane, the
+//! scalar watertight test's result on the same corner values, so hits are bit for bit those of brute
+//! force. Other primitives are asked through [`Primitives::intersect`].
 //!
-//! Cost: 256 bytes per node (about `n / (5 * leaf size)` nodes), 36 bytes per triangle; the collapse
+//! Cost: 256 bytes per node (about `n / (5 * leaf size)` nodes), 160 bytes per block of up to four
+//! triangles; the collapse
 //! is linear in the binary tree's size.
 
 mod traverse;
@@ -27,7 +29,7 @@ pub(super) use traverse::{intersect_with, Kernel};
 
 use super::Node;
 use crate::accel::Primitives;
-use crate::math::Vec3;
+use crate::geometry::{Tri4, TriangleMesh};
 
 /// Children per wide node.
 pub const WIDTH: usize = 8;
@@ -65,78 +67,120 @@ pub(super) struct Ref {
     pub count: u32,
 }
 
+/// Four triangles of one leaf, as SIMD lanes, and their primitive indices. A leaf of `n` triangles is
+/// `ceil(n / 4)` consecutive blocks; lanes past `n` in its last block repeat a triangle and are never
+/// tested.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(16))]
+pub struct LeafBlock {
+    /// The corners.
+    pub tris: Tri4,
+    /// Each lane's primitive index.
+    pub prim: [u32; 4],
+}
+
 /// The 8-wide tree and, for triangle meshes, the triangles in leaf order.
 #[derive(Debug, Clone, Default)]
 pub struct Wide {
     nodes: Vec<Node8>,
     /// The root: node 0, or a single leaf; `None` for an empty tree.
     root: Option<Ref>,
-    tris: Option<Vec<[Vec3; 3]>>,
+    /// For triangle meshes, the leaves' triangles (leaves then refer to their first block instead of
+    /// their first primitive index).
+    blocks: Option<Vec<LeafBlock>>,
+}
+
+/// What the collapse reads and writes.
+struct Collapse<'a> {
+    bin: &'a [Node],
+    indices: &'a [u32],
+    mesh: Option<&'a TriangleMesh>,
+    nodes: Vec<Node8>,
+    blocks: Vec<LeafBlock>,
+}
+
+impl Collapse<'_> {
+    /// The reference to binary leaf `b`, copying its triangles into blocks for a mesh.
+    fn leaf(&mut self, b: &Node) -> Ref {
+        let count = b.count as u32;
+        let Some(mesh) = self.mesh else { return Ref { child: b.offset, count } };
+        let first = self.blocks.len() as u32;
+        let range = b.offset as usize..b.offset as usize + b.count as usize;
+        for ids in self.indices[range].chunks(4) {
+            let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
+            let tris = prim.map(|i| mesh.triangle(i as usize));
+            self.blocks.push(LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim });
+        }
+        Ref { child: first, count }
+    }
+
+    /// Writes the wide node for binary inner node `i` and its subtree; returns its index.
+    fn node(&mut self, i: usize) -> u32 {
+        let bin = self.bin;
+        let mut kids = [0usize; WIDTH];
+        kids[0] = i + 1;
+        kids[1] = bin[i].offset as usize;
+        let mut n = 2;
+        while n < WIDTH {
+            // Open the inner child most likely to be visited.
+            let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
+                let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
+                sa.total_cmp(&sb)
+            });
+            let Some(k) = best else { break };
+            let open = kids[k];
+            kids[k] = open + 1;
+            kids[n] = bin[open].offset as usize;
+            n += 1;
+        }
+        let index = self.nodes.len();
+        self.nodes.push(Node8::EMPTY);
+        let mut node = Node8::EMPTY;
+        for (lane, &c) in kids[..n].iter().enumerate() {
+            let b = &bin[c];
+            for a in 0..3 {
+                node.min[a][lane] = b.min[a];
+                node.max[a][lane] = b.max[a];
+            }
+            let r = if b.is_leaf() { self.leaf(b) } else { Ref { child: self.node(c), count: 0 } };
+            node.child[lane] = r.child;
+            node.count[lane] = r.count;
+        }
+        self.nodes[index] = node;
+        index as u32
+    }
 }
 
 impl Wide {
     /// Collapses the binary tree `bin` (depth-first layout) whose leaves refer to `indices`.
-    pub(super) fn collapse<P: Primitives + ?Sized>(bin: &[Node], indices: &[u32], live: usize, prims: &P) -> Wide {
-        let tris =
-            prims.triangle_mesh().map(|mesh| indices[..live].iter().map(|&i| mesh.triangle(i as usize)).collect());
-        let Some(root) = bin.first() else {
-            return Wide { nodes: Vec::new(), root: None, tris };
+    pub(super) fn collapse<P: Primitives + ?Sized>(bin: &[Node], indices: &[u32], prims: &P) -> Wide {
+        let mesh = prims.triangle_mesh();
+        let mut c = Collapse { bin, indices, mesh, nodes: Vec::new(), blocks: Vec::new() };
+        let root = match bin.first() {
+            None => None,
+            Some(root) if root.is_leaf() => Some(c.leaf(root)),
+            Some(_) => {
+                c.nodes.reserve(bin.len() / 4);
+                c.blocks.reserve(indices.len() / 3);
+                Some(Ref { child: c.node(0), count: 0 })
+            }
         };
-        if root.is_leaf() {
-            let root = Ref { child: root.offset, count: root.count as u32 };
-            return Wide { nodes: Vec::new(), root: Some(root), tris };
-        }
-        let mut nodes = Vec::with_capacity(bin.len() / 2);
-        collapse_node(bin, 0, &mut nodes);
-        Wide { nodes, root: Some(Ref { child: 0, count: 0 }), tris }
+        Wide { nodes: c.nodes, root, blocks: mesh.map(|_| c.blocks) }
     }
 
-    /// Bytes of the wide nodes and the triangle copy.
+    /// Bytes of the wide nodes and the triangle blocks.
     pub fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node8>()
-            + self.tris.as_ref().map_or(0, |t| t.len() * std::mem::size_of::<[Vec3; 3]>())
+            + self.blocks.as_ref().map_or(0, |b| b.len() * std::mem::size_of::<LeafBlock>())
     }
 
     /// The wide nodes (node 0 is the root when the root is not a leaf).
     pub fn nodes(&self) -> &[Node8] {
         &self.nodes
     }
-}
 
-/// Writes the wide node for binary inner node `i` and its subtree; returns its index.
-fn collapse_node(bin: &[Node], i: usize, out: &mut Vec<Node8>) -> u32 {
-    let mut kids = [0usize; WIDTH];
-    kids[0] = i + 1;
-    kids[1] = bin[i].offset as usize;
-    let mut n = 2;
-    while n < WIDTH {
-        // Open the inner child most likely to be visited.
-        let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
-            let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
-            sa.total_cmp(&sb)
-        });
-        let Some(k) = best else { break };
-        let open = kids[k];
-        kids[k] = open + 1;
-        kids[n] = bin[open].offset as usize;
-        n += 1;
+    /// The triangle blocks (empty unless the primitives are a mesh).
+    pub fn blocks(&self) -> &[LeafBlock] {
+        self.blocks.as_deref().unwrap_or(&[])
     }
-    let index = out.len();
-    out.push(Node8::EMPTY);
-    let mut node = Node8::EMPTY;
-    for (lane, &c) in kids[..n].iter().enumerate() {
-        let b = &bin[c];
-        for a in 0..3 {
-            node.min[a][lane] = b.min[a];
-            node.max[a][lane] = b.max[a];
-        }
-        if b.is_leaf() {
-            node.child[lane] = b.offset;
-            node.count[lane] = b.count as u32;
-        } else {
-            node.child[lane] = collapse_node(bin, c, out);
-        }
-    }
-    out[index] = node;
-    index as u32
 }

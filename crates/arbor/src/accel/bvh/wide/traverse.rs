@@ -21,9 +21,9 @@ use std::mem::MaybeUninit;
 
 use super::super::traverse::next_up;
 use super::super::MAX_DEPTH;
-use super::{Node8, Ref, Wide, WIDTH};
+use super::{LeafBlock, Node8, Ref, Wide, WIDTH};
 use crate::accel::{Hit, PrimHit, Primitives, TraversalCounts, BOX_SLACK};
-use crate::geometry::{intersect_triangle_in, RayFrame};
+use crate::geometry::{intersect_triangles4, RayFrame};
 use crate::math::Ray;
 
 /// At most `WIDTH - 1` entries are pushed per level of the current path.
@@ -36,7 +36,8 @@ pub enum Kernel {
     Avx2,
     /// Two 4-lane SSE halves.
     Sse,
-    /// A loop over the lanes.
+    /// A loop over the lanes (used on x86_64 only by the unit test that compares the kernels).
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
     Scalar,
 }
 
@@ -253,6 +254,17 @@ fn prefetch(wide: &Wide, r: Ref) {
     let _ = (wide, r);
 }
 
+/// The blocks of leaf `leaf` with the lanes to test in each (all four but in the last block).
+#[inline(always)]
+fn leaf_blocks(blocks: &[LeafBlock], leaf: Ref) -> impl Iterator<Item = (&LeafBlock, u32)> {
+    let first = leaf.child as usize;
+    let n = leaf.count as usize;
+    blocks[first..first + n.div_ceil(4)].iter().enumerate().map(move |(k, b)| {
+        let left = n - 4 * k;
+        (b, if left >= 4 { 0b1111 } else { (1 << left) - 1 })
+    })
+}
+
 /// True when no query can hit anything: invalid ray or an empty `(0, t_max)`.
 #[inline]
 fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
@@ -372,16 +384,18 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                 continue;
             }
         } else {
-            let first = cur.child as usize;
-            let range = first..first + cur.count as usize;
-            match &wide.tris {
-                Some(tris) => {
-                    for (k, [a, b, c]) in range.clone().zip(&tris[range]) {
-                        if COUNT {
-                            counts.prims += 1;
-                        }
-                        if let Some(h) = intersect_triangle_in(&frame, *a, *b, *c, t_query) {
-                            let hit = Hit::new(indices[k], PrimHit::new(h.t, h.b1, h.b2));
+            match &wide.blocks {
+                Some(blocks) => {
+                    if COUNT {
+                        counts.prims += cur.count;
+                    }
+                    for (block, lanes) in leaf_blocks(blocks, cur) {
+                        let h = intersect_triangles4(&frame, &block.tris, lanes, t_query);
+                        let mut m = h.mask;
+                        while m != 0 {
+                            let l = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            let hit = Hit::new(block.prim[l], PrimHit::new(h.t[l], h.b1[l], h.b2[l]));
                             if hit.beats(&best) {
                                 t_far = hit.t;
                                 t_query = next_up(hit.t);
@@ -391,6 +405,8 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                     }
                 }
                 None => {
+                    let first = cur.child as usize;
+                    let range = first..first + cur.count as usize;
                     for &prim in &indices[range] {
                         let h = if COUNT {
                             prims.intersect_counted(prim as usize, ray, t_query, counts)
@@ -489,13 +505,13 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
                 continue;
             }
         } else {
-            let first = cur.child as usize;
-            let range = first..first + cur.count as usize;
-            let hit = match &wide.tris {
-                Some(tris) => {
-                    tris[range].iter().any(|[a, b, c]| intersect_triangle_in(&frame, *a, *b, *c, t_max).is_some())
+            let hit = match &wide.blocks {
+                Some(blocks) => leaf_blocks(blocks, cur)
+                    .any(|(block, lanes)| intersect_triangles4(&frame, &block.tris, lanes, t_max).mask != 0),
+                None => {
+                    let first = cur.child as usize;
+                    indices[first..first + cur.count as usize].iter().any(|&p| prims.occludes(p as usize, ray, t_max))
                 }
-                None => indices[range].iter().any(|&p| prims.occludes(p as usize, ray, t_max)),
             };
             if hit {
                 return true;
