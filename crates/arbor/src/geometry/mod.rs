@@ -5,6 +5,7 @@ mod mesh;
 mod plane;
 mod sphere;
 mod triangle;
+mod triangle4;
 mod triangle_box;
 mod triangle_clip;
 
@@ -12,5 +13,6 @@ pub use mesh::{MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::{intersect_triangle, intersect_triangle_in, RayFrame, TriHit};
+pub use triangle4::{intersect_triangles4, Tri4, Tri4Hits};
 pub use triangle_box::triangle_overlaps_box;
 pub use triangle_clip::clip_triangle_bounds;
