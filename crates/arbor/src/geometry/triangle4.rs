@@ -333,8 +333,13 @@ mod tests {
                 rng.vec3() * 2.0 - 1.0
             }
         };
-        match int(rng, 10) {
+        match int(rng, 13) {
             0 => [q + off(rng), q + off(rng), q + off(rng)],
+            10..=12 => {
+                // q is the centroid: a hit unless degenerate or behind.
+                let (u, v) = (rng.vec3() * 2.0 - 1.0, rng.vec3() * 2.0 - 1.0);
+                [q + u, q + v, q - u - v]
+            }
             1 => [q, q + off(rng), q + off(rng)],
             2 => {
                 let u = off(rng);
@@ -411,7 +416,7 @@ mod tests {
     fn tri4_matches_scalar_bit_for_bit() {
         let mut rng = Rng(0x7121_4a4e_5eed_0001);
         let mut cov = Coverage::default();
-        for case in 0..300_000u32 {
+        for case in 0..500_000u32 {
             let mut ray = random_ray(&mut rng);
             let n = 1 + int(&mut rng, 4);
             let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(n);
@@ -420,16 +425,23 @@ mod tests {
                 tris.push(random_triangle(&mut rng, &ray, prev));
             }
             // Huge and tiny scenes: scale the origin and the triangles together.
-            let scale = match int(&mut rng, 10) {
+            // The scaled t is cubic in the coordinates: it overflows at 1e13 and is subnormal at 1e-13,
+            // so huge and tiny scenes test the non-finite and underflow paths, the others hit. A large
+            // translation makes every coordinate difference round.
+            let scale = match int(&mut rng, 16) {
                 0 => 1e30,
                 1 => 1e-30,
-                2 => 1e-36,
+                2 => 1e12,
+                3 => 1e-12,
+                4 => 1e-14,
+                5 => 3e-13,
                 _ => 1.0,
             };
-            if scale != 1.0 {
-                ray = Ray::new(ray.origin * scale, ray.dir);
+            let shift = if int(&mut rng, 16) == 0 { Vec3::new(1e6, -3e5, 7e4) } else { Vec3::ZERO };
+            if scale != 1.0 || shift != Vec3::ZERO {
+                ray = Ray::new(ray.origin * scale + shift, ray.dir);
                 for t in &mut tris {
-                    *t = t.map(|p| p * scale);
+                    *t = t.map(|p| p * scale + shift);
                 }
             }
             let cull = int(&mut rng, 8) == 0;
@@ -473,7 +485,7 @@ mod tests {
                         cov.hits += 1;
                         cov.fallback_hits += fb as u64;
                         cov.culling_hits += cull as u64;
-                        cov.scaled_hits += (scale != 1.0) as u64;
+                        cov.scaled_hits += (scale != 1.0 || shift != Vec3::ZERO) as u64;
                     }
                     if let (Some(p), Some(w)) = (probe, want) {
                         if w.t == p.t && t_max == f32::from_bits(p.t.to_bits() + 1) {
