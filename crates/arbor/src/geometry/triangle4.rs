@@ -295,8 +295,7 @@ mod tests {
         }
     }
 
-    const SPECIAL: [f32; 8] =
-        [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, -f32::MAX, 1e-45, 0.0, -0.0];
+    const SPECIAL: [f32; 8] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, -f32::MAX, 1e-45, 0.0, -0.0];
 
     /// A ray: random, axis-aligned (either sign), or on the grid with a small integer direction, the
     /// last two being where edge functions come out exactly zero.
@@ -333,8 +332,17 @@ mod tests {
                 rng.vec3() * 2.0 - 1.0
             }
         };
-        match int(rng, 13) {
+        match int(rng, 15) {
             0 => [q + off(rng), q + off(rng), q + off(rng)],
+            13 | 14 => {
+                // Grazing: nearly parallel to the ray, reaching far along it both ways, crossing it at a
+                // t of the order of its own error bound (log-uniform around it), which decides there.
+                let a = [1.0, 30.0, 1e3][int(rng, 3)];
+                let t0 = a * f32::EPSILON * (2.0f32).powi(int(rng, 12) as i32 - 2);
+                let h = ray.origin + t0 * ray.dir;
+                let (w1, w2) = (rng.vec3() * 2.0 - 1.0, rng.vec3() * 2.0 - 1.0);
+                [h + a * ray.dir + w1, h - a * ray.dir + w2, h - w1 - w2]
+            }
             10..=12 => {
                 // q is the centroid: a hit unless degenerate or behind.
                 let (u, v) = (rng.vec3() * 2.0 - 1.0, rng.vec3() * 2.0 - 1.0);
@@ -397,6 +405,7 @@ mod tests {
         t_max_at_hit_kept: u64,
         t_max_at_hit_rejected: u64,
         scaled_hits: u64,
+        subnormal_hits: u64,
     }
 
     #[test]
@@ -444,6 +453,25 @@ mod tests {
                     *t = t.map(|p| p * scale + shift);
                 }
             }
+            // Hits at subnormal and tiny t: triangles in the plane through 0 across the major axis, the
+            // origin a tiny distance off it (their scaled t and `t_max * det` are subnormal).
+            if int(&mut rng, 10) == 0 {
+                let k = RayFrame::new(&ray).kz;
+                let tiny = [1e-40, 3e-42, 1e-44, 2e-38, 1e-30, 1e-7][int(&mut rng, 6)] * range(&mut rng, 0.5, 8.0);
+                ray.origin[k] = -ray.dir[k].signum() * tiny;
+                let mut o = ray.origin;
+                o[k] = 0.0;
+                for t in &mut tris {
+                    let (u, v) = (rng.vec3() * 2.0 - 1.0, rng.vec3() * 2.0 - 1.0);
+                    *t = [o + u, o + v, o - u - v].map(|mut p| {
+                        p[k] = 0.0;
+                        p
+                    });
+                    if rng.f32() < 0.3 {
+                        t[int(&mut rng, 3)][k] = [1e-40, -1e-40, 1e-44, 0.5][int(&mut rng, 4)];
+                    }
+                }
+            }
             let cull = int(&mut rng, 8) == 0;
             ray = ray.with_culling(cull);
             let f = RayFrame::new(&ray);
@@ -485,6 +513,7 @@ mod tests {
                         cov.hits += 1;
                         cov.fallback_hits += fb as u64;
                         cov.culling_hits += cull as u64;
+                        cov.subnormal_hits += (want.unwrap().t < f32::MIN_POSITIVE) as u64;
                         cov.scaled_hits += (scale != 1.0 || shift != Vec3::ZERO) as u64;
                     }
                     if let (Some(p), Some(w)) = (probe, want) {
@@ -504,7 +533,7 @@ mod tests {
         eprintln!("{cov:?}");
         assert!(cov.hits > 100_000, "{cov:?}");
         assert!(cov.fallback_lanes > 20_000 && cov.fallback_hits > 5_000, "{cov:?}");
-        assert!(cov.culling_hits > 5_000 && cov.scaled_hits > 10_000, "{cov:?}");
+        assert!(cov.culling_hits > 5_000 && cov.scaled_hits > 10_000 && cov.subnormal_hits > 5_000, "{cov:?}");
         assert!(cov.t_max_at_hit_kept > 5_000 && cov.t_max_at_hit_rejected > 5_000, "{cov:?}");
     }
 }
