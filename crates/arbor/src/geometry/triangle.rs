@@ -32,15 +32,15 @@ fn permute(v: Vec3, kx: usize, ky: usize, kz: usize) -> Vec3 {
 /// [`intersect_triangle`].
 #[derive(Debug, Clone, Copy)]
 pub struct RayFrame {
-    origin: Vec3,
-    dir: Vec3,
-    cull_backfaces: bool,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    pub(crate) origin: Vec3,
+    pub(crate) dir: Vec3,
+    pub(crate) cull_backfaces: bool,
+    pub(crate) kx: usize,
+    pub(crate) ky: usize,
+    pub(crate) kz: usize,
+    pub(crate) sx: f32,
+    pub(crate) sy: f32,
+    pub(crate) sz: f32,
 }
 
 impl RayFrame {
