@@ -3,10 +3,12 @@
 //! Each node bins its primitives' centroids into `bins` equal slabs along the axis of largest centroid
 //! extent, sweeps the bins once from each side to get the cost of the `bins - 1` candidate planes,
 //!
-//! `cost(k) = traversal + intersection * (n_left * area_left + n_right * area_right) / area_node`,
+//! `cost(k) = traversal + intersection * (b(n_left) * area_left + b(n_right) * area_right) / area_node`,
 //!
-//! and partitions at the cheapest one; a node of at most `max_leaf_prims` primitives becomes a leaf when
-//! that cost is not below `intersection * n`. Nodes whose centroids all coincide, and nodes below
+//! where `b(n) = ceil(n / leaf_block)` counts the blocks of triangles a leaf tests at once (Embree's
+//! block-aware SAH; 1 primitive per block for other primitives), and partitions at the cheapest one; a
+//! node of at most `max_leaf_prims` primitives becomes a leaf when that cost is not below
+//! `intersection * b(n)`. Nodes whose centroids all coincide, and nodes below
 //! [`MAX_SAH_DEPTH`], are split in the middle of their index range until they fit a leaf.
 //!
 //! The build works on a temporary tree of boxed nodes, then writes the flat array depth first. Large
@@ -257,7 +259,7 @@ fn find_split(prims: &[BuildPrim], bounds: &Aabb, depth: usize, params: &BvhPara
         // but a range split keeps the recursion finite whatever the inputs.
         return Some(Split::Middle { axis });
     }
-    let leaf_cost = params.intersection_cost as f64 * n as f64;
+    let leaf_cost = params.intersection_cost as f64 * n.div_ceil(params.leaf_block) as f64;
     if n <= params.max_leaf_prims && cost >= leaf_cost {
         return None;
     }
@@ -280,7 +282,7 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
     for k in (1..nb).rev() {
         b = b.union(boxes[k]);
         c += counts[k];
-        right_cost[k - 1] = c as f64 * b.aabb().area_f64();
+        right_cost[k - 1] = c.div_ceil(params.leaf_block) as f64 * b.aabb().area_f64();
     }
     // A node of zero area (primitives on a line) makes every plane cost the same; the first one with
     // primitives on both sides wins, and that is all a degenerate node needs.
@@ -295,7 +297,9 @@ fn best_bin(prims: &[BuildPrim], bounds: &Aabb, binner: &Binner, params: &BvhPar
             continue;
         }
         let cost = params.traversal_cost as f64
-            + params.intersection_cost as f64 * (c as f64 * b.aabb().area_f64() + right_cost[k]) * inv_area;
+            + params.intersection_cost as f64
+                * (c.div_ceil(params.leaf_block) as f64 * b.aabb().area_f64() + right_cost[k])
+                * inv_area;
         if cost < best.1 {
             best = (k, cost);
         }

@@ -110,14 +110,18 @@ pub struct BvhParams {
     pub bins: usize,
     /// Cost of visiting one node, relative to `intersection_cost`.
     pub traversal_cost: f32,
-    /// Cost of intersecting one primitive.
+    /// Cost of intersecting one primitive, or one block of `leaf_block` triangles.
     pub intersection_cost: f32,
+    /// Triangles a leaf tests at once (the SIMD lanes of `wide::LeafBlock`): the SAH counts a leaf's
+    /// primitives in blocks of this many, so that it prefers full blocks. Triangle meshes only; other
+    /// primitives are tested one at a time and always count as blocks of one. Clamped to `1..=8`.
+    pub leaf_block: usize,
 }
 
 impl Default for BvhParams {
     /// 16 bins, leaves of up to 8, and pbrt-v4's cost ratio (a node visit costs half a primitive test).
     fn default() -> Self {
-        BvhParams { max_leaf_prims: 8, bins: 16, traversal_cost: 0.5, intersection_cost: 1.0 }
+        BvhParams { max_leaf_prims: 8, bins: 16, traversal_cost: 0.5, intersection_cost: 1.0, leaf_block: 4 }
     }
 }
 
@@ -139,6 +143,7 @@ impl BvhParams {
             bins: self.bins.clamp(2, MAX_BINS),
             traversal_cost: cost(self.traversal_cost, d.traversal_cost),
             intersection_cost: cost(self.intersection_cost, d.intersection_cost),
+            leaf_block: self.leaf_block.clamp(1, 8),
         }
     }
 }
@@ -148,7 +153,8 @@ impl Params for BvhParams {
         ("leaf", "most primitives in a leaf that the SAH may keep (1-64)"),
         ("bins", "SAH bins along the split axis (2-32)"),
         ("traversal-cost", "cost of a node visit relative to a primitive test"),
-        ("intersection-cost", "cost of a primitive test"),
+        ("intersection-cost", "cost of a primitive test (of a block of triangles)"),
+        ("leaf-block", "triangles tested at once in a leaf, counted as one test by the SAH (1-8)"),
     ];
     fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
         match key {
@@ -156,6 +162,7 @@ impl Params for BvhParams {
             "bins" => self.bins = parse_value(key, value)?,
             "traversal-cost" => self.traversal_cost = parse_value(key, value)?,
             "intersection-cost" => self.intersection_cost = parse_value(key, value)?,
+            "leaf-block" => self.leaf_block = parse_value(key, value)?,
             _ => return Err(unknown_key("bvh", key, Self::KEYS)),
         }
         Ok(())
@@ -201,7 +208,11 @@ impl Bvh {
     /// Builds a BVH over `prims` with binned SAH splits.
     pub fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
         let start = Instant::now();
-        let (nodes, prim_indices, live) = build::build_sah(prims, &params.sanitized());
+        let mut params = params.sanitized();
+        if prims.triangle_mesh().is_none() {
+            params.leaf_block = 1;
+        }
+        let (nodes, prim_indices, live) = build::build_sah(prims, &params);
         Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start)
     }
 

@@ -210,7 +210,13 @@ fn bvh_stats_describe_the_tree() {
 #[test]
 fn bvh_params_are_clamped() {
     let mesh = soup(1000, 10);
-    let wild = BvhParams { max_leaf_prims: 100_000, bins: 0, traversal_cost: f32::NAN, intersection_cost: -1.0 };
+    let wild = BvhParams {
+        max_leaf_prims: 100_000,
+        bins: 0,
+        traversal_cost: f32::NAN,
+        intersection_cost: -1.0,
+        leaf_block: 0,
+    };
     let bvh = Bvh::build_sah(&mesh, &wild);
     bvh.validate(&mesh).unwrap();
     assert_matches_brute(&mesh, &bvh, &rays(500, 1));
