@@ -119,9 +119,10 @@ pub struct BvhParams {
 }
 
 impl Default for BvhParams {
-    /// 16 bins, leaves of up to 8, and pbrt-v4's cost ratio (a node visit costs half a primitive test).
+    /// 16 bins, leaves of up to 8 triangles in blocks of 4, and a node visit costing as much as a block
+    /// test (Embree's ratio; measured best of 0.5-3 on the peer meshes, `docs/performance.md`).
     fn default() -> Self {
-        BvhParams { max_leaf_prims: 8, bins: 16, traversal_cost: 0.5, intersection_cost: 1.0, leaf_block: 4 }
+        BvhParams { max_leaf_prims: 8, bins: 16, traversal_cost: 1.0, intersection_cost: 1.0, leaf_block: 4 }
     }
 }
 
