@@ -239,22 +239,19 @@ fn prefetch(wide: &Wide, r: Ref) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // Addresses only (a prefetch never faults, so no bounds check is needed): the node or block
+        // `r` refers to.
         let (p, lines) = if r.count == 0 {
-            match wide.nodes.get(r.child as usize) {
-                Some(node) => ((node as *const Node8).cast::<i8>(), 4),
-                None => return,
-            }
+            (wide.nodes.as_ptr().wrapping_add(r.child as usize).cast::<i8>(), 4)
         } else {
-            match wide.blocks.as_ref().and_then(|b| b.get(r.child as usize)) {
-                Some(block) => ((block as *const LeafBlock).cast::<i8>(), 3),
+            match &wide.blocks {
+                Some(b) => (b.as_ptr().wrapping_add(r.child as usize).cast::<i8>(), 3),
                 None => return,
             }
         };
-        // SAFETY: a prefetch never faults; every address is inside the node or the block (160 bytes).
-        unsafe {
-            for k in 0..lines {
-                _mm_prefetch::<_MM_HINT_T0>(p.add(64 * k));
-            }
+        for k in 0..lines {
+            // SAFETY: a prefetch never faults, whatever the address.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * k)) };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -361,11 +358,23 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
             let (mask, near, slack) = lanes.test::<K>(node, t_far);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
-                if mask & (mask - 1) == 0 {
+                let rest = mask & (mask - 1);
+                if rest == 0 {
                     cur = Ref { child: node.child[first], count: node.count[first] };
                     continue;
                 }
-                // Two to eight children: push them all, sort the pushed entries so that the nearest is on
+                if rest & (rest - 1) == 0 {
+                    // Two children, the common case: continue with the nearer, push the other.
+                    let second = rest.trailing_zeros() as usize;
+                    let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
+                    let r = Ref { child: node.child[push], count: node.count[push] };
+                    stack[sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
+                    sp += 1;
+                    prefetch(wide, r);
+                    cur = Ref { child: node.child[go], count: node.count[go] };
+                    continue;
+                }
+                // Three to eight children: push them all, sort the pushed entries so that the nearest is on
                 // top (farthest deepest), and continue with the nearest.
                 let base = sp;
                 let mut m = mask;
