@@ -114,8 +114,10 @@ impl Collapse<'_> {
         Ref { child: first, count }
     }
 
-    /// Writes the wide node for binary inner node `i` and its subtree; returns its index.
-    fn node(&mut self, i: usize) -> u32 {
+    /// Writes the wide node for binary inner node `i` at `index` (already reserved), then its subtree.
+    /// The inner children of a node get consecutive slots, as in Embree: a ray that enters several of
+    /// them reads neighbouring memory.
+    fn node(&mut self, index: usize, i: usize) {
         let bin = self.bin;
         let mut kids = [0usize; WIDTH];
         kids[0] = i + 1;
@@ -133,21 +135,31 @@ impl Collapse<'_> {
             kids[n] = bin[open].offset as usize;
             n += 1;
         }
-        let index = self.nodes.len();
-        self.nodes.push(Node8::EMPTY);
         let mut node = Node8::EMPTY;
+        let mut inner = [(0usize, 0usize); WIDTH];
+        let mut n_inner = 0;
         for (lane, &c) in kids[..n].iter().enumerate() {
             let b = &bin[c];
             for a in 0..3 {
                 node.min[a][lane] = b.min[a];
                 node.max[a][lane] = b.max[a];
             }
-            let r = if b.is_leaf() { self.leaf(b) } else { Ref { child: self.node(c), count: 0 } };
+            let r = if b.is_leaf() {
+                self.leaf(b)
+            } else {
+                let slot = self.nodes.len();
+                self.nodes.push(Node8::EMPTY);
+                inner[n_inner] = (slot, c);
+                n_inner += 1;
+                Ref { child: slot as u32, count: 0 }
+            };
             node.child[lane] = r.child;
             node.count[lane] = r.count;
         }
         self.nodes[index] = node;
-        index as u32
+        for &(slot, c) in &inner[..n_inner] {
+            self.node(slot, c);
+        }
     }
 }
 
@@ -169,7 +181,9 @@ impl Wide {
                     c.blocks = Vec::with_capacity(blocks);
                     advise_huge_pages(&c.blocks);
                 }
-                Some(Ref { child: c.node(0), count: 0 })
+                c.nodes.push(Node8::EMPTY);
+                c.node(0, 0);
+                Some(Ref { child: 0, count: 0 })
             }
         };
         Wide { nodes: c.nodes, root, blocks: mesh.map(|_| c.blocks) }
