@@ -220,7 +220,7 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         nodes.reserve_exact(2 * live.len() - 1);
         if rayon::current_num_threads() == 1 {
             // No parallelism to gain: the whole tree by the flat writer, straight into its array.
-            build_flat(&mut live, 0, boxes, 0, params, &mut nodes);
+            build_flat(&mut live, 0, boxes, 0, params, &mut Bins::new(), &mut nodes);
         } else {
             flatten(&build_node(&mut live, 0, boxes, 0, params), &mut nodes);
         }
@@ -276,11 +276,11 @@ fn sah_prims<P: Primitives + ?Sized>(prims: &P) -> (Vec<SahPrim>, Vec<u32>, Boxe
 fn build_node(prims: &mut [SahPrim], offset: usize, boxes: Boxes, depth: usize, params: &BvhParams) -> BuildNode {
     if prims.len() < PARALLEL_THRESHOLD {
         let mut out = Vec::with_capacity(2 * prims.len() - 1);
-        build_flat(prims, offset, boxes, depth, params, &mut out);
+        build_flat(prims, offset, boxes, depth, params, &mut Bins::new(), &mut out);
         return BuildNode::Flat(out);
     }
     let bounds = boxes.bounds.aabb();
-    let Some(split) = find_split(prims, &boxes, depth, params) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, &mut Bins::new()) else {
         return make_leaf(bounds, offset, prims.len());
     };
     let (mid, axis, l_boxes, r_boxes) = partition(prims, split);
@@ -300,11 +300,12 @@ fn build_flat(
     boxes: Boxes,
     depth: usize,
     params: &BvhParams,
+    bins: &mut Bins,
     out: &mut Vec<Node>,
 ) -> u32 {
     let bounds = boxes.bounds.aabb();
     let index = out.len() as u32;
-    let Some(split) = find_split(prims, &boxes, depth, params) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, bins) else {
         debug_assert!((1..=LEAF_HARD_MAX).contains(&prims.len()));
         out.push(Node::leaf(bounds, offset as u32, prims.len() as u16));
         return index;
@@ -312,8 +313,8 @@ fn build_flat(
     let (mid, axis, l_boxes, r_boxes) = partition(prims, split);
     let (left, right) = prims.split_at_mut(mid);
     out.push(Node::inner(bounds, 0, axis as u8));
-    build_flat(left, offset, l_boxes, depth + 1, params, out);
-    let second = build_flat(right, offset + mid, r_boxes, depth + 1, params, out);
+    build_flat(left, offset, l_boxes, depth + 1, params, bins, out);
+    let second = build_flat(right, offset + mid, r_boxes, depth + 1, params, bins, out);
     out[index as usize].offset = second;
     index
 }
@@ -373,7 +374,7 @@ pub(super) fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode 
 }
 
 /// The split to make, or `None` for a leaf.
-fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams) -> Option<Split> {
+fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams, bins: &mut Bins) -> Option<Split> {
     let n = prims.len();
     if n == 1 {
         return None;
@@ -388,7 +389,7 @@ fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams
         return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
     }
     let binner = Binner::new(axis, cb.min[axis], cb.max[axis], params.bins);
-    let best = best_bin(prims, &boxes.bounds, &binner, params);
+    let best = best_bin(prims, &boxes.bounds, &binner, params, bins);
     if !best.cost.is_finite() {
         // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
         // but a range split keeps the recursion finite whatever the inputs.
@@ -412,43 +413,59 @@ struct Best {
     right: BoxAcc,
 }
 
-/// Counts and bounds of the primitives in each bin.
-fn fill_bins<const A: usize>(prims: &[SahPrim], binner: &Binner, counts: &mut [u32], boxes: &mut [BoxAcc]) {
-    for p in prims {
-        let k = binner.bin(p.centroid_on::<A>());
-        counts[k] += 1;
-        boxes[k] = boxes[k].add_prim(p);
+/// Per-bin counts and bounds, kept empty between nodes (each node empties the bins it filled, so a
+/// small node touches only the few bins its primitives fall in).
+struct Bins {
+    counts: [u32; MAX_BINS],
+    boxes: [BoxAcc; MAX_BINS],
+}
+
+impl Bins {
+    fn new() -> Box<Bins> {
+        Box::new(Bins { counts: [0; MAX_BINS], boxes: [BoxAcc::EMPTY; MAX_BINS] })
+    }
+
+    /// Adds `prims` to the bins; returns the mask of the bins filled.
+    fn fill<const A: usize>(&mut self, prims: &[SahPrim], binner: &Binner) -> u32 {
+        let mut mask = 0u32;
+        for p in prims {
+            let k = binner.bin(p.centroid_on::<A>());
+            self.counts[k] += 1;
+            self.boxes[k] = self.boxes[k].add_prim(p);
+            mask |= 1 << k;
+        }
+        mask
     }
 }
 
 /// The cheapest plane and its SAH cost. Only planes after non-empty bins are candidates: the plane
 /// after an empty bin has the same two sides, hence the same cost, as the one after the last non-empty
 /// bin before it, which comes first and wins the tie.
-fn best_bin(prims: &[SahPrim], bounds: &BoxAcc, binner: &Binner, params: &BvhParams) -> Best {
-    let nb = binner.bins;
-    let mut counts = [0u32; MAX_BINS];
-    let mut boxes = [BoxAcc::EMPTY; MAX_BINS];
-    match binner.axis {
-        0 => fill_bins::<0>(prims, binner, &mut counts[..nb], &mut boxes[..nb]),
-        1 => fill_bins::<1>(prims, binner, &mut counts[..nb], &mut boxes[..nb]),
-        _ => fill_bins::<2>(prims, binner, &mut counts[..nb], &mut boxes[..nb]),
-    }
-    let mut used = [0usize; MAX_BINS];
+fn best_bin(prims: &[SahPrim], bounds: &BoxAcc, binner: &Binner, params: &BvhParams, bins: &mut Bins) -> Best {
+    let mask = match binner.axis {
+        0 => bins.fill::<0>(prims, binner),
+        1 => bins.fill::<1>(prims, binner),
+        _ => bins.fill::<2>(prims, binner),
+    };
+    // The non-empty bins in order.
+    let mut used = [0u8; MAX_BINS];
     let mut m = 0;
-    for (k, &c) in counts[..nb].iter().enumerate() {
-        used[m] = k;
-        m += (c > 0) as usize;
+    let mut rest = mask;
+    while rest != 0 {
+        used[m] = rest.trailing_zeros() as u8;
+        rest &= rest - 1;
+        m += 1;
     }
     let used = &used[..m];
+    let (counts, boxes) = (&bins.counts, &bins.boxes);
     // Right-to-left sweep: count times area of everything right of each candidate plane.
     let mut right_cost = [0.0f64; MAX_BINS];
-    let mut right_box = [BoxAcc::EMPTY; MAX_BINS];
     let (mut b, mut c) = (BoxAcc::EMPTY, 0u32);
     for j in (1..m).rev() {
-        b = b.union(boxes[used[j]]);
-        c += counts[used[j]];
+        let k = used[j] as usize;
+        b = b.union(boxes[k]);
+        c += counts[k];
         right_cost[j - 1] = c as f64 * b.area();
-        right_box[j - 1] = b;
     }
     // A node of zero area (primitives on a line) makes every plane cost the same; the first one
     // wins, and that is all a degenerate node needs.
@@ -456,14 +473,23 @@ fn best_bin(prims: &[SahPrim], bounds: &BoxAcc, binner: &Binner, params: &BvhPar
     let inv_area = if area > 0.0 { 1.0 / area } else { 0.0 };
     let (mut b, mut c) = (BoxAcc::EMPTY, 0u32);
     let mut best = Best { bin: 0, cost: f64::INFINITY, left: BoxAcc::EMPTY, right: BoxAcc::EMPTY };
+    let mut best_j = 0;
     for j in 0..m.saturating_sub(1) {
-        b = b.union(boxes[used[j]]);
-        c += counts[used[j]];
+        let k = used[j] as usize;
+        b = b.union(boxes[k]);
+        c += counts[k];
         let cost = params.traversal_cost as f64
             + params.intersection_cost as f64 * (c as f64 * b.area() + right_cost[j]) * inv_area;
         if cost < best.cost {
-            best = Best { bin: used[j], cost, left: b, right: right_box[j] };
+            (best.bin, best.cost, best.left, best_j) = (k, cost, b, j);
         }
+    }
+    if best.cost.is_finite() {
+        best.right = used[best_j + 1..].iter().fold(BoxAcc::EMPTY, |b, &k| b.union(boxes[k as usize]));
+    }
+    for &k in used {
+        bins.counts[k as usize] = 0;
+        bins.boxes[k as usize] = BoxAcc::EMPTY;
     }
     best
 }
