@@ -200,13 +200,26 @@ impl Binner {
     #[inline(always)]
     fn bin(&self, c: f32) -> usize {
         // The minimum centroid lands in bin 0 and the maximum in the last bin (the ratio rounds to
-        // `bins` or just below), so every candidate plane has primitives on both sides.
+        // `bins` or just below), so every candidate plane has primitives on both sides. The ratio is
+        // never negative: converting through a signed type costs fewer instructions than `as usize`.
         let k = if self.single {
-            ((c - self.min32) * self.scale32) as usize
+            ((c - self.min32) * self.scale32) as i32 as usize
         } else {
-            ((c as f64 - self.min) * self.scale) as usize
+            ((c as f64 - self.min) * self.scale) as i64 as usize
         };
         k.min(self.bins - 1)
+    }
+
+    /// Whether `bin(c) <= bin` for a plane `bin < bins - 1`, without the conversion: the ratio truncates
+    /// to at most `bin` exactly when it is below `bin + 1`.
+    #[inline(always)]
+    fn left_of(&self, c: f32, bin: usize) -> bool {
+        debug_assert!(bin + 1 < self.bins);
+        if self.single {
+            (c - self.min32) * self.scale32 < (bin + 1) as f32
+        } else {
+            (c as f64 - self.min) * self.scale < (bin + 1) as f64
+        }
     }
 }
 
@@ -516,7 +529,7 @@ fn partition(prims: &mut [SahPrim], split: Split) -> (usize, usize, Boxes, Boxes
 /// Hoare partition by bin (not stable, but a pure function of the slice, so deterministic), growing
 /// the centroid bounds of both sides on the way; returns the size of the left side and those bounds.
 fn partition_bin<const A: usize>(prims: &mut [SahPrim], binner: &Binner, bin: usize) -> (usize, BoxAcc, BoxAcc) {
-    let goes_left = |p: &SahPrim| binner.bin(p.centroid_on::<A>()) <= bin;
+    let goes_left = |p: &SahPrim| binner.left_of(p.centroid_on::<A>(), bin);
     let (mut i, mut j) = (0, prims.len());
     let (mut l, mut r) = (BoxAcc::EMPTY, BoxAcc::EMPTY);
     loop {
