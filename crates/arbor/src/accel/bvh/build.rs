@@ -14,6 +14,11 @@
 //! centroid bounds come from its parent (the union of the bins on its side, and the centroid bounds the
 //! partition grows on the way), and the root's from the setup pass that calls `Primitives::bounds` once
 //! per primitive; each primitive is 32 bytes (bounds in two SIMD vectors, index in their fourth lanes).
+//! The partition tests `ratio < bin + 1` rather than converting the bin ratio to an integer (the same
+//! test: the bin is the ratio truncated). The bins stay empty between nodes: each node empties only the
+//! bins it filled (a mask), so the many small nodes near the leaves cost little. The SAH builder splits
+//! by the centres of the bounds, which is what `Primitives::centroid` returns by default (no primitive
+//! type overrides it); the other builders, which share [`BuildPrim`], still ask `centroid`.
 //!
 //! On one thread the flat array is written directly, depth first. With more, nodes of at least
 //! [`PARALLEL_THRESHOLD`] primitives become a temporary tree of boxed nodes whose halves are built with
@@ -425,6 +430,9 @@ struct Best {
     left: BoxAcc,
     right: BoxAcc,
 }
+
+// The bins a node fills are tracked in a `u32` mask.
+const _: () = assert!(MAX_BINS <= 32);
 
 /// Per-bin counts and bounds, kept empty between nodes (each node empties the bins it filled, so a
 /// small node touches only the few bins its primitives fall in).
