@@ -85,6 +85,7 @@ struct Lanes {
 }
 
 impl Lanes {
+    #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let inv = ray.inv_dir.to_array();
         let d = ray.dir.abs();
