@@ -287,11 +287,19 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    intersect_with::<P, COUNT>(Kernel::detect(), wide, indices, prims, ray, t_max, counts)
+    match Kernel::detect() {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `detect` found AVX2.
+        Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
+        Kernel::Sse if cfg!(target_arch = "x86_64") => {
+            intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
+        }
+        _ => intersect_kernel::<P, COUNT, SCALAR>(wide, indices, prims, ray, t_max, counts),
+    }
 }
 
-/// [`intersect`] with the given kernel, which the processor must support.
-#[inline]
+/// [`intersect`] with the given kernel (tests compare the kernels).
+#[cfg(test)]
 pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
     kernel: Kernel,
     wide: &Wide,
@@ -304,8 +312,8 @@ pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT:
     match kernel {
         #[cfg(target_arch = "x86_64")]
         Kernel::Avx2 => {
-            assert!(std::is_x86_feature_detected!("avx2"));
-            // SAFETY: the processor has AVX2 (checked just above; the check is a cached load).
+            assert_eq!(Kernel::detect(), Kernel::Avx2, "this processor has no AVX2");
+            // SAFETY: the processor has AVX2 (checked just above).
             unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) }
         }
         Kernel::Sse if cfg!(target_arch = "x86_64") => {
@@ -343,7 +351,9 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
         return None;
     }
     let lanes = Lanes::new(ray);
-    let frame = RayFrame::new(ray);
+    // The triangle test's part of the ray, computed at the first leaf: many rays (a primary ray past
+    // the mesh) never reach one.
+    let mut frame: Option<RayFrame> = None;
     let mut best: Option<Hit> = None;
     // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
     let mut t_far = t_max;
@@ -406,8 +416,9 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                     if COUNT {
                         counts.prims += cur.count;
                     }
+                    let frame = frame.get_or_insert_with(|| RayFrame::new(ray));
                     for (block, lanes) in leaf_blocks(blocks, cur) {
-                        let h = intersect_triangles4(&frame, &block.tris, lanes, t_query);
+                        let h = intersect_triangles4(frame, &block.tris, lanes, t_query);
                         let mut m = h.mask;
                         while m != 0 {
                             let l = m.trailing_zeros() as usize;
@@ -502,7 +513,7 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
         return false;
     }
     let lanes = Lanes::new(ray);
-    let frame = RayFrame::new(ray);
+    let mut frame: Option<RayFrame> = None;
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;
     loop {
@@ -523,8 +534,11 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
             }
         } else {
             let hit = match &wide.blocks {
-                Some(blocks) => leaf_blocks(blocks, cur)
-                    .any(|(block, lanes)| intersect_triangles4(&frame, &block.tris, lanes, t_max).mask != 0),
+                Some(blocks) => {
+                    let frame = frame.get_or_insert_with(|| RayFrame::new(ray));
+                    leaf_blocks(blocks, cur)
+                        .any(|(block, lanes)| intersect_triangles4(frame, &block.tris, lanes, t_max).mask != 0)
+                }
                 None => {
                     let first = cur.child as usize;
                     indices[first..first + cur.count as usize].iter().any(|&p| prims.occludes(p as usize, ray, t_max))
