@@ -78,13 +78,14 @@ impl Tri4Hits {
     }
 }
 
-/// The lanes in `lanes`, each with the scalar test.
+/// `out` with the lanes in `lanes` replaced by the scalar test's results (culling rays, lanes whose
+/// edge function is exactly zero, and every lane on targets without the SIMD code).
 #[inline(never)]
 #[cold]
-fn intersect_lanes_scalar(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -> Tri4Hits {
-    let mut out = Tri4Hits::NONE;
+fn with_scalar(mut out: Tri4Hits, lanes: u32, f: &RayFrame, tris: &Tri4, t_max: f32) -> Tri4Hits {
     for l in 0..4 {
         if lanes & (1 << l) != 0 {
+            out.mask &= !(1 << l);
             out.set_scalar(l, f, tris, t_max);
         }
     }
@@ -97,7 +98,7 @@ fn intersect_lanes_scalar(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -> 
 #[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
 pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -> Tri4Hits {
-    intersect_lanes_scalar(f, tris, lanes & 0xf, t_max)
+    with_scalar(Tri4Hits::NONE, lanes & 0xf, f, tris, t_max)
 }
 
 /// The hits of the frame's ray with the lanes of `tris` whose bit is set in `lanes` (bits 0..4), in
@@ -118,7 +119,7 @@ pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -
     if f.cull_backfaces {
         // The culling test is a dot product whose rounding would need its own replica; culling rays
         // are rare (primary rays, when asked for), so they take the scalar test.
-        return intersect_lanes_scalar(f, tris, lanes, t_max);
+        return with_scalar(Tri4Hits::NONE, lanes, f, tris, t_max);
     }
     let (kx, ky, kz) = (f.kx, f.ky, f.kz);
     // SAFETY: SSE and SSE2 are part of the x86_64 baseline; the loads read `[f32; 4]` arrays of a
@@ -247,20 +248,7 @@ pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -
 #[inline(always)]
 fn finish(mut out: Tri4Hits, fallback: u32, f: &RayFrame, tris: &Tri4, t_max: f32) -> Tri4Hits {
     if fallback != 0 {
-        out = with_fallback(out, fallback, f, tris, t_max);
-    }
-    out
-}
-
-#[cfg(target_arch = "x86_64")]
-#[inline(never)]
-#[cold]
-fn with_fallback(mut out: Tri4Hits, fallback: u32, f: &RayFrame, tris: &Tri4, t_max: f32) -> Tri4Hits {
-    for l in 0..4 {
-        if fallback & (1 << l) != 0 {
-            out.mask &= !(1 << l);
-            out.set_scalar(l, f, tris, t_max);
-        }
+        out = with_scalar(out, fallback, f, tris, t_max);
     }
     out
 }
