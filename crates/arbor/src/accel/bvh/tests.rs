@@ -360,7 +360,8 @@ fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
     for ray in rays(3000, 8) {
         let run = |k: Kernel| {
             let mut c = TraversalCounts::default();
-            let hit = intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c);
+            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
+            let hit = unsafe { intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c) };
             (hit, c.nodes, c.prims)
         };
         let scalar = run(Kernel::Scalar);

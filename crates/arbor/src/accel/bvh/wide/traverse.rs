@@ -287,20 +287,16 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    match Kernel::detect() {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: `detect` found AVX2.
-        Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
-        Kernel::Sse if cfg!(target_arch = "x86_64") => {
-            intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
-        }
-        _ => intersect_kernel::<P, COUNT, SCALAR>(wide, indices, prims, ray, t_max, counts),
-    }
+    // SAFETY: `detect` gives a kernel this processor runs.
+    unsafe { intersect_with::<P, COUNT>(Kernel::detect(), wide, indices, prims, ray, t_max, counts) }
 }
 
 /// [`intersect`] with the given kernel (tests compare the kernels).
-#[cfg(test)]
-pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
+///
+/// # Safety
+/// The processor must support `kernel` (AVX2 for [`Kernel::Avx2`]).
+#[inline]
+pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
     kernel: Kernel,
     wide: &Wide,
     indices: &[u32],
@@ -311,11 +307,8 @@ pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT:
 ) -> Option<Hit> {
     match kernel {
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx2 => {
-            assert_eq!(Kernel::detect(), Kernel::Avx2, "this processor has no AVX2");
-            // SAFETY: the processor has AVX2 (checked just above).
-            unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) }
-        }
+        // SAFETY: the caller vouches for AVX2.
+        Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
         Kernel::Sse if cfg!(target_arch = "x86_64") => {
             intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
         }
