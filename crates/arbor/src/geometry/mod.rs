@@ -12,7 +12,7 @@ mod triangle_clip;
 pub use mesh::{MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;
-pub use triangle::{intersect_triangle, intersect_triangle_in, RayFrame, TriHit};
+pub use triangle::{intersect_triangle, intersect_triangle_in, major_axis, RayFrame, TriHit};
 pub use triangle4::{intersect_triangles4, Tri4, Tri4Hits};
 pub use triangle_box::triangle_overlaps_box;
 pub use triangle_clip::clip_triangle_bounds;

@@ -22,7 +22,19 @@ pub struct TriHit {
 
 #[inline]
 fn permute(v: Vec3, kx: usize, ky: usize, kz: usize) -> Vec3 {
-    Vec3::new(v[kx], v[ky], v[kz])
+    // Through an array: indexing a `Vec3` by a run-time axis is a three-way branch.
+    let a = v.to_array();
+    Vec3::new(a[kx], a[ky], a[kz])
+}
+
+/// The axis of `d`'s largest magnitude, the later of equal ones, without branches: for incoherent rays
+/// a branch on it would be mispredicted about half the time.
+#[inline]
+pub fn major_axis(d: Vec3) -> usize {
+    let a = d.abs();
+    let x_wins = a.x > a.y && a.x > a.z;
+    let y_over_z = a.y > a.z;
+    (!x_wins as usize) * (2 - y_over_z as usize)
 }
 
 /// The part of the watertight test that depends only on the ray (the paper computes it once per ray):
@@ -47,16 +59,10 @@ impl RayFrame {
     /// The frame of `ray`.
     #[inline]
     pub fn new(ray: &Ray) -> Self {
-        let ad = ray.dir.abs();
-        let kz = if ad.x > ad.y && ad.x > ad.z {
-            0
-        } else if ad.y > ad.z {
-            1
-        } else {
-            2
-        };
-        let kx = if kz == 2 { 0 } else { kz + 1 };
-        let ky = if kx == 2 { 0 } else { kx + 1 };
+        let kz = major_axis(ray.dir);
+        // (kz + 1) % 3 and (kz + 2) % 3, without division.
+        let kx = [1, 2, 0][kz];
+        let ky = [2, 0, 1][kz];
         let d = permute(ray.dir, kx, ky, kz);
         let sz = 1.0 / d.z;
         let sx = -d.x * sz;
@@ -174,6 +180,24 @@ mod tests {
     const P0: Vec3 = Vec3::new(-1.0, -1.0, 0.0);
     const P1: Vec3 = Vec3::new(1.0, -1.0, 0.0);
     const P2: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+
+    #[test]
+    fn major_axis_is_the_largest_magnitude_later_of_ties() {
+        let cases = [
+            (Vec3::new(3.0, -1.0, 2.0), 0),
+            (Vec3::new(1.0, -3.0, 2.0), 1),
+            (Vec3::new(1.0, 2.0, -3.0), 2),
+            (Vec3::new(2.0, -2.0, 1.0), 1),
+            (Vec3::new(2.0, 1.0, -2.0), 2),
+            (Vec3::new(1.0, 2.0, 2.0), 2),
+            (Vec3::splat(1.0), 2),
+            (Vec3::new(f32::NAN, 1.0, 0.5), 1),
+            (Vec3::new(1.0, 0.0, 0.0), 0),
+        ];
+        for (d, want) in cases {
+            assert_eq!(major_axis(d), want, "{d:?}");
+        }
+    }
 
     #[test]
     fn triangle_hit_reports_distance_and_barycentrics() {

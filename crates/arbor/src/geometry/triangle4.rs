@@ -131,7 +131,8 @@ pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -
         let abs = |x: __m128| _mm_andnot_ps(sign, x);
 
         // a = permute(p0 - origin), ...: the permutation picks the axis arrays.
-        let (ox, oy, oz) = (_mm_set1_ps(f.origin[kx]), _mm_set1_ps(f.origin[ky]), _mm_set1_ps(f.origin[kz]));
+        let o = f.origin.to_array();
+        let (ox, oy, oz) = (_mm_set1_ps(o[kx]), _mm_set1_ps(o[ky]), _mm_set1_ps(o[kz]));
         let mut ax = _mm_sub_ps(load(0, kx), ox);
         let mut ay = _mm_sub_ps(load(0, ky), oy);
         let mut az = _mm_sub_ps(load(0, kz), oz);
