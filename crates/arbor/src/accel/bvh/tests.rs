@@ -369,3 +369,35 @@ fn bvh_wide_kernels_return_the_same_hits_and_the_portable_ones_visit_the_same_no
         }
     }
 }
+
+#[test]
+fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_free_lanes() {
+    let mesh = soup(3000, 41);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let (nodes, blocks) = (bvh.wide.nodes(), bvh.wide.blocks());
+    let mut seen = vec![0u32; mesh.len()];
+    let mut leaf_lanes = 0;
+    for node in nodes {
+        for lane in 0..super::wide::WIDTH {
+            let count = node.count[lane] as usize;
+            if count == 0 {
+                continue;
+            }
+            leaf_lanes += 1;
+            let lo = Vec3::new(node.min[0][lane], node.min[1][lane], node.min[2][lane]);
+            let hi = Vec3::new(node.max[0][lane], node.max[1][lane], node.max[2][lane]);
+            let first = node.child[lane] as usize;
+            for (k, block) in blocks[first..first + count.div_ceil(4)].iter().enumerate() {
+                for l in 0..(count - 4 * k).min(4) {
+                    seen[block.prim[l] as usize] += 1;
+                    for p in block.tris.lane(l) {
+                        assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{p:?} outside lane box {lo:?}..{hi:?}");
+                    }
+                }
+            }
+        }
+    }
+    assert!(seen.iter().all(|&n| n == 1), "every triangle in exactly one block lane");
+    let binary_leaves = bvh.nodes.iter().filter(|n| n.is_leaf()).count();
+    assert!(leaf_lanes > binary_leaves, "leaves of two blocks split over free lanes: {leaf_lanes} vs {binary_leaves}");
+}

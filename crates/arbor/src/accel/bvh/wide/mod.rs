@@ -119,6 +119,30 @@ impl Collapse<'_> {
         Ref { child: first, count }
     }
 
+    /// Binary leaf `b` of a mesh as one reference per block of four triangles, each with the box of its
+    /// own triangles: the leaf's triangles sorted along its box's longest axis, then cut into blocks,
+    /// so that each block is a compact piece of the leaf (a ray that meets the leaf's box often meets
+    /// only one of them).
+    fn split_leaf(&mut self, b: &Node, mesh: &TriangleMesh) -> impl Iterator<Item = (Aabb, Ref)> {
+        let bounds = b.bounds();
+        let axis = bounds.longest_axis();
+        let mut ids: Vec<u32> = self.indices[b.offset as usize..b.offset as usize + b.count as usize].to_vec();
+        let key = |i: u32| {
+            let [p0, p1, p2] = mesh.triangle(i as usize);
+            p0[axis] + p1[axis] + p2[axis]
+        };
+        ids.sort_by(|&x, &y| key(x).total_cmp(&key(y)).then(x.cmp(&y)));
+        let mut out = Vec::with_capacity(ids.len().div_ceil(4));
+        for chunk in ids.chunks(4) {
+            let prim: [u32; 4] = std::array::from_fn(|l| chunk[l.min(chunk.len() - 1)]);
+            let tris = prim.map(|i| mesh.triangle(i as usize));
+            let bounds = Aabb::from_points(tris[..chunk.len()].iter().flatten().copied());
+            out.push((bounds, Ref { child: self.blocks.len() as u32, count: chunk.len() as u32 }));
+            self.blocks.push(LeafBlock { tris: Tri4::new(&tris[..chunk.len()]), prim });
+        }
+        out.into_iter()
+    }
+
     /// Writes the wide node for binary inner node `i` at `index` (already reserved), then its subtree.
     /// The inner children of a node get consecutive slots, as in Embree: a ray that enters several of
     /// them reads neighbouring memory.
@@ -140,14 +164,43 @@ impl Collapse<'_> {
             kids[n] = bin[open].offset as usize;
             n += 1;
         }
+        // Lanes left over go to the blocks of leaves of more than one block, largest leaves first:
+        // a lane costs nothing in the node test, and a block behind its own box is tested only by
+        // rays that meet that box.
+        let mut split = [false; WIDTH];
+        if self.mesh.is_some() {
+            let mut free = WIDTH - n;
+            let mut leaves: Vec<usize> = (0..n).filter(|&k| bin[kids[k]].count > 4).collect();
+            leaves.sort_by(|&a, &b| bin[kids[b]].bounds().area_f64().total_cmp(&bin[kids[a]].bounds().area_f64()));
+            for k in leaves {
+                let extra = (bin[kids[k]].count as usize).div_ceil(4) - 1;
+                if extra <= free {
+                    free -= extra;
+                    split[k] = true;
+                }
+            }
+        }
         let mut node = Node8::EMPTY;
         let mut inner = [(0usize, 0usize); WIDTH];
         let mut n_inner = 0;
-        for (lane, &c) in kids[..n].iter().enumerate() {
-            let b = &bin[c];
+        let mut lane = 0;
+        let mut put = |node: &mut Node8, bounds: Aabb, r: Ref| {
             for a in 0..3 {
-                node.min[a][lane] = b.min[a];
-                node.max[a][lane] = b.max[a];
+                node.min[a][lane] = bounds.min[a];
+                node.max[a][lane] = bounds.max[a];
+            }
+            node.child[lane] = r.child;
+            node.count[lane] = r.count;
+            lane += 1;
+        };
+        for (k, &c) in kids[..n].iter().enumerate() {
+            let b = &bin[c];
+            if split[k] {
+                let mesh = self.mesh.expect("only mesh leaves are split");
+                for (bounds, r) in self.split_leaf(b, mesh) {
+                    put(&mut node, bounds, r);
+                }
+                continue;
             }
             let r = if b.is_leaf() {
                 self.leaf(b)
@@ -158,8 +211,7 @@ impl Collapse<'_> {
                 n_inner += 1;
                 Ref { child: slot as u32, count: 0 }
             };
-            node.child[lane] = r.child;
-            node.count[lane] = r.count;
+            put(&mut node, b.bounds(), r);
         }
         self.nodes[index] = node;
         for &(slot, c) in &inner[..n_inner] {
