@@ -183,14 +183,17 @@ impl Lanes {
         let mut far = _mm256_set1_ps(t_far);
         let slack;
         if self.fused {
-            for a in 0..3 {
+            let slab = |a: usize| {
                 let inv = _mm256_loadu_ps(self.inv[a].as_ptr());
                 let o = _mm256_loadu_ps(self.org_inv[a].as_ptr());
                 let t0 = _mm256_fmsub_ps(_mm256_load_ps(base.add(self.enter[a])), inv, o);
                 let t1 = _mm256_fmsub_ps(_mm256_load_ps(base.add(self.exit[a])), inv, o);
-                near = _mm256_max_ps(t0, near);
-                far = _mm256_min_ps(t1, far);
-            }
+                (t0, t1)
+            };
+            let ((x0, x1), (y0, y1), (z0, z1)) = (slab(0), slab(1), slab(2));
+            // No NaN arises here (finite `inv`, no overflow), so the reductions may be trees.
+            near = _mm256_max_ps(_mm256_max_ps(x0, y0), _mm256_max_ps(z0, near));
+            far = _mm256_min_ps(_mm256_min_ps(x1, y1), _mm256_min_ps(z1, far));
             slack = _mm256_set1_ps(self.slack);
         } else {
             let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
