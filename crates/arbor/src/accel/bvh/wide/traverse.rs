@@ -418,7 +418,6 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                 counts.nodes += 1;
             }
             let (mask, near) = lanes.test::<K>(node, t_far);
-
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
