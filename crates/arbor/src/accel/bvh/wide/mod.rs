@@ -15,11 +15,14 @@
 //! leaf loop reads consecutive memory instead of chasing two indices per triangle and tests four
 //! triangles at once ([`crate::geometry::intersect_triangles4`]); that test gives, lane by lane, the
 //! scalar watertight test's result on the same corner values, so hits are bit for bit those of brute
-//! force. Other primitives are asked through [`Primitives::intersect`].
+//! force. A node's unused lanes go to the blocks of its leaves of more than one block: such a leaf's
+//! triangles are sorted along its longest axis and each block of four gets a lane with the box of its
+//! own triangles (still a box that holds its triangles, so the traversal's argument is untouched).
+//! Other primitives are asked through [`Primitives::intersect`].
 //!
 //! Cost: 256 bytes per node (about `n / (5 * leaf size)` nodes), 160 bytes per block of up to four
-//! triangles; the collapse
-//! is linear in the binary tree's size.
+//! triangles; the collapse is linear in the binary tree's size (plus a sort of each split leaf's few
+//! triangles).
 
 mod traverse;
 
@@ -112,9 +115,7 @@ impl Collapse<'_> {
         let first = self.blocks.len() as u32;
         let range = b.offset as usize..b.offset as usize + b.count as usize;
         for ids in self.indices[range].chunks(4) {
-            let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
-            let tris = prim.map(|i| mesh.triangle(i as usize));
-            self.blocks.push(LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim });
+            push_block(&mut self.blocks, mesh, ids);
         }
         Ref { child: first, count }
     }
@@ -123,24 +124,20 @@ impl Collapse<'_> {
     /// own triangles: the leaf's triangles sorted along its box's longest axis, then cut into blocks,
     /// so that each block is a compact piece of the leaf (a ray that meets the leaf's box often meets
     /// only one of them).
-    fn split_leaf(&mut self, b: &Node, mesh: &TriangleMesh) -> impl Iterator<Item = (Aabb, Ref)> {
-        let bounds = b.bounds();
-        let axis = bounds.longest_axis();
+    fn split_leaf(&mut self, b: &Node, mesh: &TriangleMesh) -> Vec<(Aabb, Ref)> {
+        let axis = b.bounds().longest_axis();
         let mut ids: Vec<u32> = self.indices[b.offset as usize..b.offset as usize + b.count as usize].to_vec();
         let key = |i: u32| {
             let [p0, p1, p2] = mesh.triangle(i as usize);
             p0[axis] + p1[axis] + p2[axis]
         };
         ids.sort_by(|&x, &y| key(x).total_cmp(&key(y)).then(x.cmp(&y)));
-        let mut out = Vec::with_capacity(ids.len().div_ceil(4));
-        for chunk in ids.chunks(4) {
-            let prim: [u32; 4] = std::array::from_fn(|l| chunk[l.min(chunk.len() - 1)]);
-            let tris = prim.map(|i| mesh.triangle(i as usize));
-            let bounds = Aabb::from_points(tris[..chunk.len()].iter().flatten().copied());
-            out.push((bounds, Ref { child: self.blocks.len() as u32, count: chunk.len() as u32 }));
-            self.blocks.push(LeafBlock { tris: Tri4::new(&tris[..chunk.len()]), prim });
-        }
-        out.into_iter()
+        ids.chunks(4)
+            .map(|chunk| {
+                let bounds = Aabb::from_points(chunk.iter().flat_map(|&i| mesh.triangle(i as usize)));
+                (bounds, Ref { child: push_block(&mut self.blocks, mesh, chunk), count: chunk.len() as u32 })
+            })
+            .collect()
     }
 
     /// Writes the wide node for binary inner node `i` at `index` (already reserved), then its subtree.
@@ -263,6 +260,15 @@ impl Wide {
     pub fn blocks(&self) -> &[LeafBlock] {
         self.blocks.as_deref().unwrap_or(&[])
     }
+}
+
+/// Appends the block of triangles `ids` (one to four) to `blocks`; returns its index. Lanes past the
+/// last triangle repeat it (the traversal never tests them).
+fn push_block(blocks: &mut Vec<LeafBlock>, mesh: &TriangleMesh, ids: &[u32]) -> u32 {
+    let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
+    let tris = prim.map(|i| mesh.triangle(i as usize));
+    blocks.push(LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim });
+    blocks.len() as u32 - 1
 }
 
 /// Asks Linux to back the 2 MiB-aligned part of `v`'s allocation with transparent huge pages, as
