@@ -158,7 +158,7 @@ impl Lanes {
         {
             if K == AVX2 {
                 // SAFETY: `AVX2` is only instantiated inside `intersect_avx2`/`occluded_avx2`, which are
-                // called only when the processor has AVX2.
+                // called only when the processor has AVX2 and FMA.
                 return unsafe { self.test_avx2(node, t_far) };
             }
             if K == SSE {
@@ -352,7 +352,7 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
 /// [`intersect`] with the given kernel (tests compare the kernels).
 ///
 /// # Safety
-/// The processor must support `kernel` (AVX2 for [`Kernel::Avx2`]).
+/// The processor must support `kernel` (AVX2 and FMA for [`Kernel::Avx2`]).
 #[inline]
 pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
     kernel: Kernel,
@@ -365,7 +365,7 @@ pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const
 ) -> Option<Hit> {
     match kernel {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller vouches for AVX2.
+        // SAFETY: the caller vouches for AVX2 and FMA.
         Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
         Kernel::Sse if cfg!(target_arch = "x86_64") => {
             intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
@@ -374,7 +374,7 @@ pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const
     }
 }
 
-/// The whole query compiled for AVX2, so that the node test inlines.
+/// The whole query compiled for AVX2 and FMA, so that the node test inlines.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn intersect_avx2<P: Primitives + ?Sized, const COUNT: bool>(
@@ -533,7 +533,7 @@ pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
 ) -> bool {
     match Kernel::detect() {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: `detect` found AVX2.
+        // SAFETY: `detect` found AVX2 and FMA.
         Kernel::Avx2 => unsafe { occluded_avx2(wide, indices, prims, ray, t_max) },
         Kernel::Sse if cfg!(target_arch = "x86_64") => occluded_kernel::<P, SSE>(wide, indices, prims, ray, t_max),
         _ => occluded_kernel::<P, SCALAR>(wide, indices, prims, ray, t_max),
