@@ -89,10 +89,6 @@ pub struct Wide {
     nodes: Vec<Node8>,
     /// The root: node 0, or a single leaf; `None` for an empty tree.
     root: Option<Ref>,
-    /// The root's box, which holds every other box (it bounds a ray's slab distances in any node).
-    bounds: Aabb,
-    /// The largest magnitude of a coordinate of `bounds`.
-    reach: f32,
     /// For triangle meshes, the leaves' triangles (leaves then refer to their first block instead of
     /// their first primitive index).
     blocks: Option<Vec<LeafBlock>>,
@@ -240,9 +236,7 @@ impl Wide {
                 Some(Ref { child: 0, count: 0 })
             }
         };
-        let bounds = bin.first().map_or(Aabb::EMPTY, Node::bounds);
-        let reach = bounds.min.abs().max(bounds.max.abs()).max_element();
-        Wide { nodes: c.nodes, root, bounds, reach, blocks: mesh.map(|_| c.blocks) }
+        Wide { nodes: c.nodes, root, blocks: mesh.map(|_| c.blocks) }
     }
 
     /// Bytes of the wide nodes and the triangle blocks.

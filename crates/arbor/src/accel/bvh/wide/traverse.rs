@@ -2,23 +2,20 @@
 //!
 //! Hand-written SIMD (`std::arch`) because this loop is the hot core of every query: the eight slab
 //! tests share the ray's broadcast origin and reciprocal direction, and the per-axis choice of the entry
-//! plane is precomputed as load offsets, so a node test is a few instructions without branches. With
-//! AVX2 and FMA (detected at run time, once per query) the eight lanes are one register, the whole query
-//! is compiled for them, and a slab distance is one FMA for most rays ([`Lanes::new`]); without them,
-//! two SSE halves (SSE2 is the x86_64 baseline); elsewhere, scalar code. The SSE and scalar kernels
-//! compute the same per-lane arithmetic, so they visit the same nodes; the fused AVX2 test visits a
-//! superset (unit test). The stack lives in uninitialised memory so that a query does not pay for
-//! clearing it.
+//! plane is precomputed as load offsets, so a node test is about 20 instructions without branches. With
+//! AVX2 (detected at run time, once per query) the eight lanes are one register and the whole query is
+//! compiled for AVX2; without it, two SSE halves (SSE2 is the x86_64 baseline); elsewhere, scalar code.
+//! All three compute the same per-lane arithmetic, so they visit the same nodes (unit test). The stack
+//! lives in uninitialised memory so that a query does not pay for clearing it.
 //!
 //! Exactness against brute force follows the binary traversal (`../traverse.rs`), whose argument holds
 //! lane by lane: the box test is the same conservative test, `near <= far + scale * SLACK` with `scale`
-//! the larger slab distance on the ray's major axis, or the fused test, which accepts every box that one
-//! accepts; `max`/`min` take the accumulator as the operand that wins over a NaN, as `f32::max`/`min`
-//! do; a node at exactly the best `t` is still visited; leaves ask for hits up to the float above the
-//! best `t` and keep ties by lowest primitive index. Children are pushed farthest first with their
-//! entry distance; a popped entry is skipped when `near > t_far + slack`, with `slack` the ray's bound
-//! on every lane's slack, which is implied by failing its box test against the current `t_far` (float
-//! addition is monotone), so the skip never drops a box that test would keep.
+//! the larger slab distance on the ray's major axis; `max`/`min` take the accumulator as the operand
+//! that wins over a NaN, as `f32::max`/`min` do; a node at exactly the best `t` is still visited; leaves
+//! ask for hits up to the float above the best `t` and keep ties by lowest primitive index.
+//! Children are pushed farthest first with their entry distance and slack; a popped entry is skipped
+//! when `near > t_far + slack`, which is implied by failing its box test against the current `t_far`
+//! (float addition is monotone), so the skip never drops a box that test would keep.
 
 use std::mem::MaybeUninit;
 
@@ -27,7 +24,7 @@ use super::super::MAX_DEPTH;
 use super::{LeafBlock, Node8, Ref, Wide, WIDTH};
 use crate::accel::{Hit, PrimHit, Primitives, TraversalCounts, BOX_SLACK};
 use crate::geometry::{intersect_triangles4, RayFrame};
-use crate::math::{Aabb, Ray};
+use crate::math::Ray;
 
 /// At most `WIDTH - 1` entries are pushed per level of the current path.
 const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
@@ -35,8 +32,7 @@ const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
 /// The code that tests a node's boxes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kernel {
-    /// One 8-lane AVX2 register per axis and side, slab distances by FMA where the ray allows (see
-    /// `Lanes::new`); needs AVX2 and FMA.
+    /// One 8-lane AVX2 register per axis and side.
     Avx2,
     /// Two 4-lane SSE halves.
     Sse,
@@ -51,7 +47,7 @@ impl Kernel {
     pub fn detect() -> Kernel {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            if std::is_x86_feature_detected!("avx2") {
                 Kernel::Avx2
             } else {
                 Kernel::Sse
@@ -71,84 +67,37 @@ const SCALAR: u8 = 2;
 struct Entry {
     r: Ref,
     near: f32,
+    slack: f32,
 }
 
-/// What a node test returns: the lanes whose box the ray meets in `[0, t_far]` (bit per lane) and their
-/// entry distances.
-type Tested = (u32, [f32; WIDTH]);
+/// What a node test returns: the lanes whose box the ray meets in `[0, t_far]` (bit per lane), their
+/// entry distances and their slacks.
+type Tested = (u32, [f32; WIDTH], [f32; WIDTH]);
 
 /// A ray prepared for eight-box tests: per axis, where the entry and exit planes are in a node (as `f32`
-/// offsets into it), the origin and reciprocal direction broadcast to all lanes (stored whole, so that
-/// a node test loads each as one register).
+/// offsets into it), the broadcast origin and reciprocal direction.
 struct Lanes {
     enter: [usize; 3],
     exit: [usize; 3],
     org: [f32; 3],
-    inv: [[f32; WIDTH]; 3],
-    /// `org * inv`, rounded: the fused test's `t = box * inv - org_inv` is one FMA per plane.
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    org_inv: [[f32; WIDTH]; 3],
+    inv: [f32; 3],
     major: usize,
-    /// Whether the AVX2 kernel uses the fused test (see [`Lanes::new`]).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    fused: bool,
-    /// The fused test's slack, and for every test a bound on any lane's slack: a popped entry is skipped
-    /// when `near > t_far + slack`.
-    slack: f32,
 }
 
 impl Lanes {
-    /// The ray's constants for the nodes below `root` (a box that holds them all, no coordinate of
-    /// which exceeds `root_reach` in magnitude).
-    ///
-    /// The fused test computes a slab distance as `fma(box, inv, -round(org * inv))`, one rounding
-    /// after an exact product, instead of `(box - org) * inv`; `near <= far + slack` with one slack
-    /// for the whole ray. It accepts every box the separate test accepts (so the exactness argument
-    /// of the module carries over) when `slack >= T * (SLACK + 32u) + 16u * P` (u = 2^-24), with `T`
-    /// the largest slab distance to the root box on the major axis (which bounds the separate test's
-    /// per-lane slack, and the `near` and `far` of any box it accepts) and `P` the largest `|org * inv|`
-    /// (`p <= 256 T` keeps the second term below `T / 4096`):
-    /// each slab distance of either test is within `2u * (P + |t|)` of the exact one; a distance above
-    /// `near` or below `far` can only move them by as much, and in an accepted box both are within
-    /// about `T`; the margin covers the roundings of the comparison and of the slacks. Where `P` is
-    /// large next to `T` (an origin far from the scene's planes on an axis the ray nearly parallels)
-    /// that slack would let in boxes well off the ray, and where the distances could overflow or
-    /// `inv` is infinite the bound does not hold: such rays take the separate test.
     #[inline(always)]
-    fn new(ray: &Ray, root: &Aabb, root_reach: f32) -> Self {
+    fn new(ray: &Ray) -> Self {
         let inv = ray.inv_dir.to_array();
-        let org = ray.origin.to_array();
         let major = crate::geometry::major_axis(ray.dir);
         // `min` is at f32 offset 8a, `max` at 24 + 8a (`Node8` is `repr(C)`).
         let neg = |a: usize| inv[a].is_sign_negative();
         let w = WIDTH;
-        // In f32: the margins of the slacks below absorb a few roundings of these bounds. `max` as a
-        // plain comparison (a NaN gives the second operand), not the NaN-aware `f32::max`.
-        let max = |a: f32, b: f32| if a > b { a } else { b };
-        let max3 = |v: [f32; 3]| max(max(v[0].abs(), v[1].abs()), v[2].abs());
-        let (lo, hi) = (root.min.to_array()[major] - org[major], root.max.to_array()[major] - org[major]);
-        let t_major = max(lo.abs(), hi.abs()) * inv[major].abs();
-        let org_inv = [org[0] * inv[0], org[1] * inv[1], org[2] * inv[2]];
-        let p = max3(org_inv);
-        const U: f32 = f32::EPSILON / 2.0;
-        // No slab distance overflows when `(|org| + |box|) * |inv|` stays below 1e29; comparisons with a
-        // NaN are false, so a NaN anywhere means the separate test.
-        let fused = (max3(org) + root_reach) * max3(inv) < 1e29 && p <= 256.0 * t_major;
-        let slack = if fused {
-            t_major * (BOX_SLACK + 32.0 * U) + 16.0 * U * p + 4.0 * f32::MIN_POSITIVE
-        } else {
-            t_major * BOX_SLACK * (1.0 + 16.0 * U)
-        };
         Lanes {
             enter: std::array::from_fn(|a| if neg(a) { 3 * w + w * a } else { w * a }),
             exit: std::array::from_fn(|a| if neg(a) { w * a } else { 3 * w + w * a }),
-            org,
-            inv: inv.map(|x| [x; WIDTH]),
-            org_inv: org_inv.map(|x| [x; WIDTH]),
+            org: ray.origin.to_array(),
+            inv,
             major,
-            fused,
-            // A NaN bound (from a NaN `t_major`) becomes infinite: nothing is skipped.
-            slack: if slack.is_nan() { f32::INFINITY } else { slack },
         }
     }
 
@@ -158,7 +107,7 @@ impl Lanes {
         {
             if K == AVX2 {
                 // SAFETY: `AVX2` is only instantiated inside `intersect_avx2`/`occluded_avx2`, which are
-                // called only when the processor has AVX2 and FMA.
+                // called only when the processor has AVX2.
                 return unsafe { self.test_avx2(node, t_far) };
             }
             if K == SSE {
@@ -168,55 +117,40 @@ impl Lanes {
         self.test_scalar(node, t_far)
     }
 
-    /// The eight lanes in one AVX register per row: the fused test when the ray allows it, else the
-    /// separate one.
+    /// The eight lanes in one AVX register per row.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
+    #[target_feature(enable = "avx2")]
     #[inline]
     unsafe fn test_avx2(&self, node: &Node8, t_far: f32) -> Tested {
         use std::arch::x86_64::*;
         let base = (node as *const Node8).cast::<f32>();
         let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
         // Every offset is below 48 floats, inside the 256-byte node, and a multiple of 8 floats from
-        // its 64-byte aligned start, as `_mm256_load_ps` requires; the store goes to a local array.
+        // its 64-byte aligned start, as `_mm256_load_ps` requires; the stores go to local arrays.
+        let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
         let mut near = _mm256_setzero_ps();
         let mut far = _mm256_set1_ps(t_far);
-        let slack;
-        if self.fused {
-            let slab = |a: usize| {
-                let inv = _mm256_loadu_ps(self.inv[a].as_ptr());
-                let o = _mm256_loadu_ps(self.org_inv[a].as_ptr());
-                let t0 = _mm256_fmsub_ps(_mm256_load_ps(base.add(self.enter[a])), inv, o);
-                let t1 = _mm256_fmsub_ps(_mm256_load_ps(base.add(self.exit[a])), inv, o);
-                (t0, t1)
-            };
-            let ((x0, x1), (y0, y1), (z0, z1)) = (slab(0), slab(1), slab(2));
-            // No NaN arises here (finite `inv`, no overflow), so the reductions may be trees.
-            near = _mm256_max_ps(_mm256_max_ps(x0, y0), _mm256_max_ps(z0, near));
-            far = _mm256_min_ps(_mm256_min_ps(x1, y1), _mm256_min_ps(z1, far));
-            slack = _mm256_set1_ps(self.slack);
-        } else {
-            let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
-            let mut scale = _mm256_setzero_ps();
-            for a in 0..3 {
-                let o = _mm256_set1_ps(self.org[a]);
-                let inv = _mm256_loadu_ps(self.inv[a].as_ptr());
-                let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.enter[a])), o), inv);
-                let t1 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.exit[a])), o), inv);
-                // The second operand is returned when either is NaN: the accumulator wins, as in
-                // `f32::max`.
-                near = _mm256_max_ps(t0, near);
-                far = _mm256_min_ps(t1, far);
-                if a == self.major {
-                    scale = _mm256_max_ps(_mm256_and_ps(t0, abs), scale);
-                    scale = _mm256_max_ps(_mm256_and_ps(t1, abs), scale);
-                }
+        let mut scale = _mm256_setzero_ps();
+        for a in 0..3 {
+            let o = _mm256_set1_ps(self.org[a]);
+            let inv = _mm256_set1_ps(self.inv[a]);
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.enter[a])), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(base.add(self.exit[a])), o), inv);
+            // The second operand is returned when either is NaN: the accumulator wins, as in
+            // `f32::max`.
+            near = _mm256_max_ps(t0, near);
+            far = _mm256_min_ps(t1, far);
+            if a == self.major {
+                scale = _mm256_max_ps(_mm256_and_ps(t0, abs), scale);
+                scale = _mm256_max_ps(_mm256_and_ps(t1, abs), scale);
             }
-            slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
         }
+        let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
         _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
         let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack))) as u32;
-        (mask, near_out)
+        (mask, near_out, slack_out)
     }
 
     /// The eight lanes as two SSE halves.
@@ -226,10 +160,11 @@ impl Lanes {
         use std::arch::x86_64::*;
         let base = (node as *const Node8).cast::<f32>();
         let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
         let mut mask = 0;
         // SAFETY: SSE2 is part of the x86_64 baseline; every offset is below 48 floats, inside the
         // 256-byte node, and a multiple of 4 floats from its 64-byte aligned start, as `_mm_load_ps`
-        // requires; the stores go to a local array of eight floats at offsets 0 and 4.
+        // requires; the stores go to local arrays of eight floats at offsets 0 and 4.
         unsafe {
             let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
             for half in [0, 4] {
@@ -238,7 +173,7 @@ impl Lanes {
                 let mut scale = _mm_setzero_ps();
                 for a in 0..3 {
                     let o = _mm_set1_ps(self.org[a]);
-                    let inv = _mm_loadu_ps(self.inv[a].as_ptr());
+                    let inv = _mm_set1_ps(self.inv[a]);
                     let t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.enter[a] + half)), o), inv);
                     let t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(self.exit[a] + half)), o), inv);
                     near = _mm_max_ps(t0, near);
@@ -250,10 +185,11 @@ impl Lanes {
                 }
                 let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
                 _mm_storeu_ps(near_out.as_mut_ptr().add(half), near);
+                _mm_storeu_ps(slack_out.as_mut_ptr().add(half), slack);
                 mask |= (_mm_movemask_ps(_mm_cmple_ps(near, _mm_add_ps(far, slack))) as u32) << half;
             }
         }
-        (mask, near_out)
+        (mask, near_out, slack_out)
     }
 
     /// The same test one lane at a time.
@@ -261,12 +197,13 @@ impl Lanes {
     fn test_scalar(&self, node: &Node8, t_far: f32) -> Tested {
         let flat: &[f32; 64] = float_view(node);
         let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
         let mut mask = 0;
         for lane in 0..WIDTH {
             let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
             for a in 0..3 {
-                let t0 = (flat[self.enter[a] + lane] - self.org[a]) * self.inv[a][0];
-                let t1 = (flat[self.exit[a] + lane] - self.org[a]) * self.inv[a][0];
+                let t0 = (flat[self.enter[a] + lane] - self.org[a]) * self.inv[a];
+                let t1 = (flat[self.exit[a] + lane] - self.org[a]) * self.inv[a];
                 near = near.max(t0);
                 far = far.min(t1);
                 if a == self.major {
@@ -275,9 +212,10 @@ impl Lanes {
             }
             let slack = scale * BOX_SLACK;
             near_out[lane] = near;
+            slack_out[lane] = slack;
             mask |= ((near <= far + slack) as u32) << lane;
         }
-        (mask, near_out)
+        (mask, near_out, slack_out)
     }
 }
 
@@ -352,7 +290,7 @@ pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool
 /// [`intersect`] with the given kernel (tests compare the kernels).
 ///
 /// # Safety
-/// The processor must support `kernel` (AVX2 and FMA for [`Kernel::Avx2`]).
+/// The processor must support `kernel` (AVX2 for [`Kernel::Avx2`]).
 #[inline]
 pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
     kernel: Kernel,
@@ -365,7 +303,7 @@ pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const
 ) -> Option<Hit> {
     match kernel {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller vouches for AVX2 and FMA.
+        // SAFETY: the caller vouches for AVX2.
         Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
         Kernel::Sse if cfg!(target_arch = "x86_64") => {
             intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
@@ -374,9 +312,9 @@ pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const
     }
 }
 
-/// The whole query compiled for AVX2 and FMA, so that the node test inlines.
+/// The whole query compiled for AVX2, so that the node test inlines.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
 unsafe fn intersect_avx2<P: Primitives + ?Sized, const COUNT: bool>(
     wide: &Wide,
     indices: &[u32],
@@ -401,7 +339,7 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
     if trivially_misses(ray, t_max) {
         return None;
     }
-    let lanes = Lanes::new(ray, &wide.bounds, wide.reach);
+    let lanes = Lanes::new(ray);
     // The triangle test's part of the ray, computed at the first leaf: many rays (a primary ray past
     // the mesh) never reach one.
     let mut frame: Option<RayFrame> = None;
@@ -417,7 +355,7 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
             if COUNT {
                 counts.nodes += 1;
             }
-            let (mask, near) = lanes.test::<K>(node, t_far);
+            let (mask, near, slack) = lanes.test::<K>(node, t_far);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -431,7 +369,7 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                     let second = rest.trailing_zeros() as usize;
                     let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
                     let r = Ref { child: node.child[push], count: node.count[push] };
-                    stack[sp] = MaybeUninit::new(Entry { r, near: near[push] });
+                    stack[sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
                     sp += 1;
                     prefetch(wide, r);
                     cur = Ref { child: node.child[go], count: node.count[go] };
@@ -445,7 +383,8 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                 while m != 0 {
                     let l = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let e = Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l] };
+                    let e =
+                        Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
                     // Insertion by decreasing `near`.
                     let mut j = sp;
                     // SAFETY: `base..sp` were written in this loop.
@@ -514,7 +453,7 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
             let e = unsafe { stack[sp].assume_init() };
             // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
             #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(e.near > t_far + lanes.slack) {
+            if !(e.near > t_far + e.slack) {
                 cur = e.r;
                 break;
             }
@@ -533,7 +472,7 @@ pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
 ) -> bool {
     match Kernel::detect() {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: `detect` found AVX2 and FMA.
+        // SAFETY: `detect` found AVX2.
         Kernel::Avx2 => unsafe { occluded_avx2(wide, indices, prims, ray, t_max) },
         Kernel::Sse if cfg!(target_arch = "x86_64") => occluded_kernel::<P, SSE>(wide, indices, prims, ray, t_max),
         _ => occluded_kernel::<P, SCALAR>(wide, indices, prims, ray, t_max),
@@ -541,7 +480,7 @@ pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
 unsafe fn occluded_avx2<P: Primitives + ?Sized>(
     wide: &Wide,
     indices: &[u32],
@@ -564,14 +503,14 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
     if trivially_misses(ray, t_max) {
         return false;
     }
-    let lanes = Lanes::new(ray, &wide.bounds, wide.reach);
+    let lanes = Lanes::new(ray);
     let mut frame: Option<RayFrame> = None;
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;
     loop {
         if cur.count == 0 {
             let node = &wide.nodes[cur.child as usize];
-            let (mut mask, _) = lanes.test::<K>(node, t_max);
+            let (mut mask, _, _) = lanes.test::<K>(node, t_max);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
