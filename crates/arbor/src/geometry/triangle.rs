@@ -68,8 +68,16 @@ impl RayFrame {
         } else {
             2
         };
-        let kx = if kz == 2 { 0 } else { kz + 1 };
-        let ky = if kx == 2 { 0 } else { kx + 1 };
+        Self::with_major(ray, kz)
+    }
+
+    /// The frame of `ray` whose [`major_axis`] is already known to be `kz` (a traversal computes it
+    /// for its box test): no branch on the direction, which incoherent rays would mispredict.
+    #[inline]
+    pub fn with_major(ray: &Ray, kz: usize) -> Self {
+        debug_assert_eq!(kz, major_axis(ray.dir));
+        const NEXT: [usize; 3] = [1, 2, 0];
+        let (kx, ky) = (NEXT[kz], NEXT[NEXT[kz]]);
         let d = permute(ray.dir, kx, ky, kz);
         let sz = 1.0 / d.z;
         let sx = -d.x * sz;

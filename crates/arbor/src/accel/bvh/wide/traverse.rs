@@ -75,7 +75,10 @@ struct Entry {
 type Tested = (u32, [f32; WIDTH], [f32; WIDTH]);
 
 /// A ray prepared for eight-box tests: per axis, where the entry and exit planes are in a node (as `f32`
-/// offsets into it), the broadcast origin and reciprocal direction.
+/// offsets into it), the broadcast origin and reciprocal direction; and the major axis (the
+/// direction's largest component), whose slab distances size the box slack and which the triangle
+/// test's frame shears along. (Storing the axes major first, to take the slack without asking which
+/// axis it is, made primary rays 5% slower: the permuted setup sits on every query's critical path.)
 struct Lanes {
     enter: [usize; 3],
     exit: [usize; 3],
@@ -226,33 +229,152 @@ fn float_view(node: &Node8) -> &[f32; 64] {
     unsafe { &*(node as *const Node8).cast::<[f32; 64]>() }
 }
 
-/// Asks the cache for what `r` refers to (an inner node's four cache lines, or a leaf's first block),
-/// so that a child pushed now is in cache when popped: these fetches are most of a query's stalls. The
-/// child the query goes on with is fetched too: its box test loads only its first three lines, and
-/// without the prefetch the fourth (the child references) would be asked for only after that test,
-/// a second trip to memory in a row (diffuse rays on the 1M mesh +10%).
-#[inline(always)]
-fn prefetch(wide: &Wide, r: Ref) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // Addresses only (a prefetch never faults, so no bounds check is needed): the node or block
-        // `r` refers to.
-        let (p, lines) = if r.count == 0 {
-            (wide.nodes.as_ptr().wrapping_add(r.child as usize).cast::<i8>(), 4)
-        } else {
-            match &wide.blocks {
-                Some(b) => (b.as_ptr().wrapping_add(r.child as usize).cast::<i8>(), 3),
-                None => return,
-            }
-        };
-        for k in 0..lines {
-            // SAFETY: a prefetch never faults, whatever the address.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * k)) };
+/// What a query does at a leaf: a mesh's leaves are blocks of four triangles tested at once, other
+/// primitives are asked one by one. The traversal is compiled once per kind (see [`query`]), so the
+/// mesh loop carries no call into other primitives' code.
+trait Leaves {
+    /// Asks the cache for leaf `r`'s first block, so that a leaf pushed now is in cache when popped.
+    fn prefetch(&self, r: Ref);
+    /// Offers leaf `r`'s hits below `best.t_query` to `best`.
+    fn closest<const COUNT: bool>(
+        &self,
+        r: Ref,
+        ray: &Ray,
+        major: usize,
+        frame: &mut Option<RayFrame>,
+        best: &mut Best,
+        counts: &mut TraversalCounts,
+    );
+    /// Whether leaf `r` has a hit in `(0, t_max)`.
+    fn any(&self, r: Ref, ray: &Ray, major: usize, frame: &mut Option<RayFrame>, t_max: f32) -> bool;
+}
+
+/// The closest hit so far; primitives are asked for hits below `t_query`, just above its `t`, to see
+/// ties (kept by lowest primitive index).
+struct Best {
+    hit: Option<Hit>,
+    t_far: f32,
+    t_query: f32,
+}
+
+impl Best {
+    #[inline(always)]
+    fn offer(&mut self, hit: Hit) {
+        if hit.beats(&self.hit) {
+            self.t_far = hit.t;
+            self.t_query = next_up(hit.t);
+            self.hit = Some(hit);
         }
     }
+}
+
+struct MeshLeaves<'a> {
+    blocks: &'a [LeafBlock],
+}
+
+impl Leaves for MeshLeaves<'_> {
+    #[inline(always)]
+    fn prefetch(&self, r: Ref) {
+        prefetch_lines(self.blocks.as_ptr().wrapping_add(r.child as usize).cast(), 3);
+    }
+
+    #[inline(always)]
+    fn closest<const COUNT: bool>(
+        &self,
+        r: Ref,
+        ray: &Ray,
+        major: usize,
+        frame: &mut Option<RayFrame>,
+        best: &mut Best,
+        counts: &mut TraversalCounts,
+    ) {
+        if COUNT {
+            counts.prims += r.count;
+        }
+        let frame = frame.get_or_insert_with(|| RayFrame::with_major(ray, major));
+        for (block, lanes) in leaf_blocks(self.blocks, r) {
+            let h = intersect_triangles4(frame, &block.tris, lanes, best.t_query);
+            let mut m = h.mask;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                best.offer(Hit::new(block.prim[l], PrimHit::new(h.t[l], h.b1[l], h.b2[l])));
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any(&self, r: Ref, ray: &Ray, major: usize, frame: &mut Option<RayFrame>, t_max: f32) -> bool {
+        let frame = frame.get_or_insert_with(|| RayFrame::with_major(ray, major));
+        leaf_blocks(self.blocks, r)
+            .any(|(block, lanes)| intersect_triangles4(frame, &block.tris, lanes, t_max).mask != 0)
+    }
+}
+
+struct PrimLeaves<'a, P: ?Sized> {
+    indices: &'a [u32],
+    prims: &'a P,
+}
+
+impl<P: Primitives + ?Sized> Leaves for PrimLeaves<'_, P> {
+    #[inline(always)]
+    fn prefetch(&self, _: Ref) {}
+
+    #[inline(always)]
+    fn closest<const COUNT: bool>(
+        &self,
+        r: Ref,
+        ray: &Ray,
+        _: usize,
+        _: &mut Option<RayFrame>,
+        best: &mut Best,
+        counts: &mut TraversalCounts,
+    ) {
+        let first = r.child as usize;
+        for &prim in &self.indices[first..first + r.count as usize] {
+            let h = if COUNT {
+                self.prims.intersect_counted(prim as usize, ray, best.t_query, counts)
+            } else {
+                self.prims.intersect(prim as usize, ray, best.t_query)
+            };
+            if let Some(h) = h {
+                best.offer(Hit::new(prim, h));
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any(&self, r: Ref, ray: &Ray, _: usize, _: &mut Option<RayFrame>, t_max: f32) -> bool {
+        let first = r.child as usize;
+        self.indices[first..first + r.count as usize].iter().any(|&p| self.prims.occludes(p as usize, ray, t_max))
+    }
+}
+
+/// Asks the cache for `lines` cache lines from `p`. Most of a query's stalls are the first loads of a
+/// node or block: a child pushed now is fetched while its siblings are traversed. The child the query
+/// goes on with is fetched too: its box test loads only its first three lines, and without the
+/// prefetch the fourth (the child references) would be asked for only after that test, a second
+/// trip to memory in a row (diffuse rays on the 1M mesh +10%).
+#[inline(always)]
+fn prefetch_lines(p: *const i8, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for k in 0..lines {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch never faults, whatever the address (so `p` needs no bounds check).
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * k)) };
+    }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (wide, r);
+    let _ = (p, lines);
+}
+
+/// Prefetches what `r` refers to: an inner node's four cache lines, or a leaf's first block.
+#[inline(always)]
+fn prefetch<L: Leaves>(nodes: &[Node8], leaves: &L, r: Ref) {
+    if r.count == 0 {
+        prefetch_lines(nodes.as_ptr().wrapping_add(r.child as usize).cast(), 4);
+    } else {
+        leaves.prefetch(r);
+    }
 }
 
 /// The blocks of leaf `leaf` with the lanes to test in each (all four but in the last block).
@@ -335,33 +457,47 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    let mut cur = wide.root?;
+    let root = wide.root?;
     if trivially_misses(ray, t_max) {
         return None;
     }
+    match &wide.blocks {
+        Some(blocks) => query::<_, COUNT, K>(&wide.nodes, &MeshLeaves { blocks }, root, ray, t_max, counts),
+        None => query::<_, COUNT, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, ray, t_max, counts),
+    }
+}
+
+/// The closest-hit traversal from `root`.
+#[inline(always)]
+fn query<L: Leaves, const COUNT: bool, const K: u8>(
+    nodes: &[Node8],
+    leaves: &L,
+    root: Ref,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
     let lanes = Lanes::new(ray);
     // The triangle test's part of the ray, computed at the first leaf: many rays (a primary ray past
     // the mesh) never reach one.
     let mut frame: Option<RayFrame> = None;
-    let mut best: Option<Hit> = None;
-    // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
-    let mut t_far = t_max;
-    let mut t_query = t_max;
+    let mut best = Best { hit: None, t_far: t_max, t_query: t_max };
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
     let mut sp = 0usize;
+    let mut cur = root;
     loop {
         if cur.count == 0 {
-            let node = &wide.nodes[cur.child as usize];
+            let node = &nodes[cur.child as usize];
             if COUNT {
                 counts.nodes += 1;
             }
-            let (mask, near, slack) = lanes.test::<K>(node, t_far);
+            let (mask, near, slack) = lanes.test::<K>(node, best.t_far);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
                 if rest == 0 {
                     cur = Ref { child: node.child[first], count: node.count[first] };
-                    prefetch(wide, cur);
+                    prefetch(nodes, leaves, cur);
                     continue;
                 }
                 if rest & (rest - 1) == 0 {
@@ -371,9 +507,9 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                     let r = Ref { child: node.child[push], count: node.count[push] };
                     stack[sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
                     sp += 1;
-                    prefetch(wide, r);
+                    prefetch(nodes, leaves, r);
                     cur = Ref { child: node.child[go], count: node.count[go] };
-                    prefetch(wide, cur);
+                    prefetch(nodes, leaves, cur);
                     continue;
                 }
                 // Three to eight children: push them all, sort the pushed entries so that the nearest is on
@@ -394,7 +530,7 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                     }
                     stack[j] = MaybeUninit::new(e);
                     sp += 1;
-                    prefetch(wide, e.r);
+                    prefetch(nodes, leaves, e.r);
                 }
                 sp -= 1;
                 // SAFETY: written just above.
@@ -402,58 +538,18 @@ fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
                 continue;
             }
         } else {
-            match &wide.blocks {
-                Some(blocks) => {
-                    if COUNT {
-                        counts.prims += cur.count;
-                    }
-                    let frame = frame.get_or_insert_with(|| RayFrame::new(ray));
-                    for (block, lanes) in leaf_blocks(blocks, cur) {
-                        let h = intersect_triangles4(frame, &block.tris, lanes, t_query);
-                        let mut m = h.mask;
-                        while m != 0 {
-                            let l = m.trailing_zeros() as usize;
-                            m &= m - 1;
-                            let hit = Hit::new(block.prim[l], PrimHit::new(h.t[l], h.b1[l], h.b2[l]));
-                            if hit.beats(&best) {
-                                t_far = hit.t;
-                                t_query = next_up(hit.t);
-                                best = Some(hit);
-                            }
-                        }
-                    }
-                }
-                None => {
-                    let first = cur.child as usize;
-                    let range = first..first + cur.count as usize;
-                    for &prim in &indices[range] {
-                        let h = if COUNT {
-                            prims.intersect_counted(prim as usize, ray, t_query, counts)
-                        } else {
-                            prims.intersect(prim as usize, ray, t_query)
-                        };
-                        if let Some(h) = h {
-                            let hit = Hit::new(prim, h);
-                            if hit.beats(&best) {
-                                t_far = hit.t;
-                                t_query = next_up(hit.t);
-                                best = Some(hit);
-                            }
-                        }
-                    }
-                }
-            }
+            leaves.closest::<COUNT>(cur, ray, lanes.major, &mut frame, &mut best, counts);
         }
         loop {
             if sp == 0 {
-                return best;
+                return best.hit;
             }
             sp -= 1;
             // SAFETY: entries below `sp` were written by the pushes above.
             let e = unsafe { stack[sp].assume_init() };
             // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
             #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(e.near > t_far + e.slack) {
+            if !(e.near > best.t_far + e.slack) {
                 cur = e.r;
                 break;
             }
@@ -499,17 +595,27 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
     ray: &Ray,
     t_max: f32,
 ) -> bool {
-    let Some(mut cur) = wide.root else { return false };
+    let Some(root) = wide.root else { return false };
     if trivially_misses(ray, t_max) {
         return false;
     }
+    match &wide.blocks {
+        Some(blocks) => any_hit::<_, K>(&wide.nodes, &MeshLeaves { blocks }, root, ray, t_max),
+        None => any_hit::<_, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, ray, t_max),
+    }
+}
+
+/// The any-hit traversal from `root`.
+#[inline(always)]
+fn any_hit<L: Leaves, const K: u8>(nodes: &[Node8], leaves: &L, root: Ref, ray: &Ray, t_max: f32) -> bool {
     let lanes = Lanes::new(ray);
     let mut frame: Option<RayFrame> = None;
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;
+    let mut cur = root;
     loop {
         if cur.count == 0 {
-            let node = &wide.nodes[cur.child as usize];
+            let node = &nodes[cur.child as usize];
             let (mut mask, _, _) = lanes.test::<K>(node, t_max);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
@@ -523,21 +629,8 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
                 cur = Ref { child: node.child[first], count: node.count[first] };
                 continue;
             }
-        } else {
-            let hit = match &wide.blocks {
-                Some(blocks) => {
-                    let frame = frame.get_or_insert_with(|| RayFrame::new(ray));
-                    leaf_blocks(blocks, cur)
-                        .any(|(block, lanes)| intersect_triangles4(frame, &block.tris, lanes, t_max).mask != 0)
-                }
-                None => {
-                    let first = cur.child as usize;
-                    indices[first..first + cur.count as usize].iter().any(|&p| prims.occludes(p as usize, ray, t_max))
-                }
-            };
-            if hit {
-                return true;
-            }
+        } else if leaves.any(cur, ray, lanes.major, &mut frame, t_max) {
+            return true;
         }
         if sp == 0 {
             return false;
