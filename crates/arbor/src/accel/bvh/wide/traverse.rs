@@ -236,17 +236,25 @@ trait Leaves {
     /// Asks the cache for leaf `r`'s first block, so that a leaf pushed now is in cache when popped.
     fn prefetch(&self, r: Ref);
     /// Offers leaf `r`'s hits below `best.t_query` to `best`.
-    fn closest<const COUNT: bool>(
-        &self,
-        r: Ref,
-        ray: &Ray,
-        major: usize,
-        frame: &mut Option<RayFrame>,
-        best: &mut Best,
-        counts: &mut TraversalCounts,
-    );
+    fn closest<const COUNT: bool>(&self, r: Ref, q: &mut LeafRay, best: &mut Best, counts: &mut TraversalCounts);
     /// Whether leaf `r` has a hit in `(0, t_max)`.
-    fn any(&self, r: Ref, ray: &Ray, major: usize, frame: &mut Option<RayFrame>, t_max: f32) -> bool;
+    fn any(&self, r: Ref, q: &mut LeafRay, t_max: f32) -> bool;
+}
+
+/// The ray as leaves see it: the triangle test's part of it is computed at the first leaf (many rays,
+/// such as a primary ray past the mesh, never reach one), from the major axis the box test chose.
+struct LeafRay<'a> {
+    ray: &'a Ray,
+    major: usize,
+    frame: Option<RayFrame>,
+}
+
+impl LeafRay<'_> {
+    #[inline(always)]
+    fn frame(&mut self) -> &RayFrame {
+        let (ray, major) = (self.ray, self.major);
+        self.frame.get_or_insert_with(|| RayFrame::with_major(ray, major))
+    }
 }
 
 /// The closest hit so far; primitives are asked for hits below `t_query`, just above its `t`, to see
@@ -279,19 +287,11 @@ impl Leaves for MeshLeaves<'_> {
     }
 
     #[inline(always)]
-    fn closest<const COUNT: bool>(
-        &self,
-        r: Ref,
-        ray: &Ray,
-        major: usize,
-        frame: &mut Option<RayFrame>,
-        best: &mut Best,
-        counts: &mut TraversalCounts,
-    ) {
+    fn closest<const COUNT: bool>(&self, r: Ref, q: &mut LeafRay, best: &mut Best, counts: &mut TraversalCounts) {
         if COUNT {
             counts.prims += r.count;
         }
-        let frame = frame.get_or_insert_with(|| RayFrame::with_major(ray, major));
+        let frame = q.frame();
         for (block, lanes) in leaf_blocks(self.blocks, r) {
             let h = intersect_triangles4(frame, &block.tris, lanes, best.t_query);
             let mut m = h.mask;
@@ -304,8 +304,8 @@ impl Leaves for MeshLeaves<'_> {
     }
 
     #[inline(always)]
-    fn any(&self, r: Ref, ray: &Ray, major: usize, frame: &mut Option<RayFrame>, t_max: f32) -> bool {
-        let frame = frame.get_or_insert_with(|| RayFrame::with_major(ray, major));
+    fn any(&self, r: Ref, q: &mut LeafRay, t_max: f32) -> bool {
+        let frame = q.frame();
         leaf_blocks(self.blocks, r)
             .any(|(block, lanes)| intersect_triangles4(frame, &block.tris, lanes, t_max).mask != 0)
     }
@@ -321,16 +321,8 @@ impl<P: Primitives + ?Sized> Leaves for PrimLeaves<'_, P> {
     fn prefetch(&self, _: Ref) {}
 
     #[inline(always)]
-    fn closest<const COUNT: bool>(
-        &self,
-        r: Ref,
-        ray: &Ray,
-        _: usize,
-        _: &mut Option<RayFrame>,
-        best: &mut Best,
-        counts: &mut TraversalCounts,
-    ) {
-        let first = r.child as usize;
+    fn closest<const COUNT: bool>(&self, r: Ref, q: &mut LeafRay, best: &mut Best, counts: &mut TraversalCounts) {
+        let (first, ray) = (r.child as usize, q.ray);
         for &prim in &self.indices[first..first + r.count as usize] {
             let h = if COUNT {
                 self.prims.intersect_counted(prim as usize, ray, best.t_query, counts)
@@ -344,9 +336,9 @@ impl<P: Primitives + ?Sized> Leaves for PrimLeaves<'_, P> {
     }
 
     #[inline(always)]
-    fn any(&self, r: Ref, ray: &Ray, _: usize, _: &mut Option<RayFrame>, t_max: f32) -> bool {
+    fn any(&self, r: Ref, q: &mut LeafRay, t_max: f32) -> bool {
         let first = r.child as usize;
-        self.indices[first..first + r.count as usize].iter().any(|&p| self.prims.occludes(p as usize, ray, t_max))
+        self.indices[first..first + r.count as usize].iter().any(|&p| self.prims.occludes(p as usize, q.ray, t_max))
     }
 }
 
@@ -478,9 +470,7 @@ fn query<L: Leaves, const COUNT: bool, const K: u8>(
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
     let lanes = Lanes::new(ray);
-    // The triangle test's part of the ray, computed at the first leaf: many rays (a primary ray past
-    // the mesh) never reach one.
-    let mut frame: Option<RayFrame> = None;
+    let mut q = LeafRay { ray, major: lanes.major, frame: None };
     let mut best = Best { hit: None, t_far: t_max, t_query: t_max };
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
     let mut sp = 0usize;
@@ -538,7 +528,7 @@ fn query<L: Leaves, const COUNT: bool, const K: u8>(
                 continue;
             }
         } else {
-            leaves.closest::<COUNT>(cur, ray, lanes.major, &mut frame, &mut best, counts);
+            leaves.closest::<COUNT>(cur, &mut q, &mut best, counts);
         }
         loop {
             if sp == 0 {
@@ -609,7 +599,7 @@ fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
 #[inline(always)]
 fn any_hit<L: Leaves, const K: u8>(nodes: &[Node8], leaves: &L, root: Ref, ray: &Ray, t_max: f32) -> bool {
     let lanes = Lanes::new(ray);
-    let mut frame: Option<RayFrame> = None;
+    let mut q = LeafRay { ray, major: lanes.major, frame: None };
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;
     let mut cur = root;
@@ -629,7 +619,7 @@ fn any_hit<L: Leaves, const K: u8>(nodes: &[Node8], leaves: &L, root: Ref, ray: 
                 cur = Ref { child: node.child[first], count: node.count[first] };
                 continue;
             }
-        } else if leaves.any(cur, ray, lanes.major, &mut frame, t_max) {
+        } else if leaves.any(cur, &mut q, t_max) {
             return true;
         }
         if sp == 0 {
