@@ -1,7 +1,8 @@
 //! Mesh file readers: bytes -> [`TriangleMesh`] or an error located in the file.
 //!
 //! Three formats, one reader each: PLY ([`parse_ply`]: ASCII and both binary byte orders), Wavefront OBJ
-//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a file and picks the reader by extension.
+//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a file (mapped into memory when it is a regular file) and picks the reader by
+//! extension.
 //!
 //! Every reader validates what the renderer relies on, so that later stages never see bad data: every
 //! index is in range, every coordinate is finite, polygons are fan-triangulated (`v0 v1 v2 v3` ->
@@ -46,8 +47,31 @@ pub fn load_mesh(path: &Path) -> Result<TriangleMesh> {
             return Err(Error::input(Location::file(path), msg));
         }
     };
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse(&bytes, path)
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    match map_file(&file) {
+        Some(map) => parse(&map, path),
+        None => {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut &file, &mut bytes).map_err(|e| Error::io(path, e))?;
+            parse(&bytes, path)
+        }
+    }
+}
+
+/// The file's bytes mapped into memory, or `None` when it cannot be (empty, not a regular file, or
+/// the system declines): meshes are read once, front to back, and a mapping reads them straight from
+/// the page cache, where `read` would first copy them into a fresh buffer (the copy and the buffer's
+/// page faults were two thirds of loading a 19 MB binary PLY).
+fn map_file(file: &std::fs::File) -> Option<memmap2::Mmap> {
+    let meta = file.metadata().ok()?;
+    if !meta.is_file() || meta.len() == 0 {
+        return None;
+    }
+    // SAFETY: the mapping is read-only and lives only while this file is parsed. Another process
+    // truncating or rewriting the file meanwhile could change the bytes under the parser (or fault);
+    // a mesh file being loaded is not expected to change, as for any program that maps its inputs.
+    let map = unsafe { memmap2::MmapOptions::new().populate().map(file) }.ok()?;
+    Some(map)
 }
 
 /// Lines of a text file as `(1-based line number, bytes without "\n" or "\r\n")`.
@@ -221,6 +245,25 @@ mod tests {
         assert_eq!(e.to_string(), "m.obj:1:1: non-finite coordinate `1e99`");
         let e = parse_coord(b"1x", p, 2, 5).unwrap_err();
         assert_eq!(e.to_string(), "m.obj:2:5: malformed number `1x`");
+    }
+
+    #[test]
+    fn load_mesh_maps_regular_files_and_reads_the_rest() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                    element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        let path = dir.path().join("tri.ply");
+        std::fs::write(&path, text).unwrap();
+        let file = std::fs::File::open(&path).unwrap();
+        assert!(map_file(&file).is_some(), "a regular file is mapped");
+        assert_eq!(load_mesh(&path).unwrap(), parse_ply(text.as_bytes(), &path).unwrap());
+        let empty = dir.path().join("empty.ply");
+        std::fs::write(&empty, "").unwrap();
+        assert!(map_file(&std::fs::File::open(&empty).unwrap()).is_none(), "an empty file is read, not mapped");
+        assert_eq!(load_mesh(&empty).unwrap_err().to_string(), parse_ply(b"", &empty).unwrap_err().to_string());
+        let folder = dir.path().join("folder.ply");
+        std::fs::create_dir(&folder).unwrap();
+        assert!(load_mesh(&folder).unwrap_err().to_string().contains("folder.ply"));
     }
 
     #[test]
