@@ -1,8 +1,8 @@
 //! Mesh file readers: bytes -> [`TriangleMesh`] or an error located in the file.
 //!
 //! Three formats, one reader each: PLY ([`parse_ply`]: ASCII and both binary byte orders), Wavefront OBJ
-//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a file (mapped into memory when it is a regular file) and picks the reader by
-//! extension.
+//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a file (mapped into memory when it is a
+//! regular file) and picks the reader by extension.
 //!
 //! Every reader validates what the renderer relies on, so that later stages never see bad data: every
 //! index is in range, every coordinate is finite, polygons are fan-triangulated (`v0 v1 v2 v3` ->
@@ -70,8 +70,7 @@ fn map_file(file: &std::fs::File) -> Option<memmap2::Mmap> {
     // SAFETY: the mapping is read-only and lives only while this file is parsed. Another process
     // truncating or rewriting the file meanwhile could change the bytes under the parser (or fault);
     // a mesh file being loaded is not expected to change, as for any program that maps its inputs.
-    let map = unsafe { memmap2::MmapOptions::new().populate().map(file) }.ok()?;
-    Some(map)
+    unsafe { memmap2::MmapOptions::new().populate().map(file) }.ok()
 }
 
 /// Lines of a text file as `(1-based line number, bytes without "\n" or "\r\n")`.
