@@ -72,10 +72,10 @@ impl RayFrame {
     }
 
     /// The frame of `ray` whose [`major_axis`] is already known to be `kz` (a traversal computes it
-    /// for its box test): no branch on the direction, which incoherent rays would mispredict.
+    /// for its box test): no branch on the direction, which incoherent rays would mispredict. `kz`
+    /// must be `major_axis(ray.dir)`, or the hits are not those of [`intersect_triangle`].
     #[inline]
     pub fn with_major(ray: &Ray, kz: usize) -> Self {
-        debug_assert_eq!(kz, major_axis(ray.dir));
         const NEXT: [usize; 3] = [1, 2, 0];
         let (kx, ky) = (NEXT[kz], NEXT[NEXT[kz]]);
         let d = permute(ray.dir, kx, ky, kz);

@@ -253,7 +253,10 @@ impl LeafRay<'_> {
     #[inline(always)]
     fn frame(&mut self) -> &RayFrame {
         let (ray, major) = (self.ray, self.major);
-        self.frame.get_or_insert_with(|| RayFrame::with_major(ray, major))
+        self.frame.get_or_insert_with(|| {
+            debug_assert_eq!(major, crate::geometry::major_axis(ray.dir));
+            RayFrame::with_major(ray, major)
+        })
     }
 }
 
