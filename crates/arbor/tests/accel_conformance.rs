@@ -9,10 +9,12 @@
 //! again from its hit points, duplicated and coplanar triangles
 //! (ties at equal `t`), degenerate and non-finite triangles, rays along the axes (with signed zeros),
 //! rays starting inside primitive boxes and exactly on their faces, triangles mixed with spheres, empty
-//! and single-primitive sets, and NaN or infinite rays. Every family declares how many rays it casts;
-//! [`conformance_casts_a_million_rays_per_structure`] keeps the total at 10^6 or more.
+//! and single-primitive sets, and NaN or infinite rays. Every case is also traced in batches
+//! (`intersect_many`), which must give each ray the hit of its own query. Every family declares how
+//! many rays it casts; [`conformance_casts_a_million_rays_per_structure`] keeps the total at 10^6 or
+//! more.
 
-use arbor::accel::{build, AccelKind, Hit, PrimHit, Primitives};
+use arbor::accel::{build, Accel, AccelKind, Hit, PrimHit, Primitives};
 use arbor::geometry::{intersect_triangle, Sphere, TriangleMesh};
 use arbor::math::{Aabb, Ray, Transform, Vec3};
 use proptest::prelude::*;
@@ -50,6 +52,7 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> us
         let accel = build(kind, prims);
         let is_reference = kind == AccelKind::Brute;
         let step = if is_reference { 16 } else { 1 };
+        let mut single = Vec::with_capacity(probes.len());
         for (p, &(hit, occluded)) in probes.iter().zip(&expected).step_by(step) {
             if let Some(h) = hit {
                 let t_above = f32::from_bits(h.t.to_bits() + 1);
@@ -66,6 +69,7 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> us
                 continue;
             }
             let got = accel.intersect(prims, &p.ray, p.t_max);
+            single.push(got);
             assert!(
                 same_hit(got, hit),
                 "{kind} on {case}: {:?} t_max {} hit {got:?}, brute force {hit:?}",
@@ -75,8 +79,36 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> us
             let got = accel.occluded(prims, &p.ray, p.t_max);
             assert_eq!(got, occluded, "{kind} on {case}: occluded {:?} t_max {}", p.ray, p.t_max);
         }
+        if !is_reference {
+            check_batches(case, kind, accel.as_ref(), prims, probes, &single);
+        }
     }
     probes.len()
+}
+
+/// `intersect_many` gives each probe the very hit its own query gave (`single`), in batches of 1, 2, 3,
+/// 5, 8, 13 and 64 probes in turn (odd sizes leave a slot of the interleaved BVH idle, long ones refill
+/// its slots many times).
+fn check_batches<P: Primitives>(
+    case: &str,
+    kind: AccelKind,
+    accel: &dyn Accel<P>,
+    prims: &P,
+    probes: &[Probe],
+    single: &[Option<Hit>],
+) {
+    let rays: Vec<Ray> = probes.iter().map(|p| p.ray).collect();
+    let t_max: Vec<f32> = probes.iter().map(|p| p.t_max).collect();
+    let mut batched = vec![None; probes.len()];
+    let (mut start, mut k) = (0, 0);
+    while start < probes.len() {
+        let end = (start + [1, 2, 3, 5, 8, 13, 64][k % 7]).min(probes.len());
+        accel.intersect_many(prims, &rays[start..end], &t_max[start..end], &mut batched[start..end]);
+        (start, k) = (end, k + 1);
+    }
+    for (i, p) in probes.iter().enumerate() {
+        assert_eq!(batched[i], single[i], "{kind} on {case}: batch hit of probe {i} {:?} t_max {}", p.ray, p.t_max);
+    }
 }
 
 /// xorshift64*: seeded, so a failure names a reproducible case.

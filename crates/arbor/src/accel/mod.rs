@@ -191,6 +191,21 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
     fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit>;
     /// The boxes of the nodes (cells) at `depth` below the root, for the boxes debug view.
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb>;
+    /// [`Accel::intersect`] for a batch: `out[i]` becomes the closest hit of `rays[i]` in
+    /// `(0, t_max[i])`, the same hit as a query of its own. A structure may trace several rays at once
+    /// (the BVH interleaves two); the default asks one query per ray.
+    ///
+    /// # Panics
+    /// When `rays`, `t_max` and `out` differ in length.
+    fn intersect_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]) {
+        assert!(
+            rays.len() == t_max.len() && rays.len() == out.len(),
+            "a batch's rays, t_max and hits differ in length"
+        );
+        for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
+            *o = self.intersect(prims, r, t);
+        }
+    }
 }
 
 /// The structures Arbor can build.

@@ -320,6 +320,10 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
         wide::intersect::<P, true>(&self.wide, &self.prim_indices, prims, ray, t_max, counts)
     }
 
+    fn intersect_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]) {
+        wide::intersect_many(&self.wide, &self.prim_indices, prims, rays, t_max, out)
+    }
+
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
         let mut out = Vec::new();
         let mut stack = if self.nodes.is_empty() { vec![] } else { vec![(0usize, 0usize)] };

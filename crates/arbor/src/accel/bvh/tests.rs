@@ -2,7 +2,7 @@
 //! many rays is the job of `tests/accel_conformance.rs`.
 
 use super::*;
-use crate::accel::{build, AccelKind, BruteForce};
+use crate::accel::{build, AccelKind, BruteForce, PrimHit};
 use crate::geometry::TriangleMesh;
 
 pub(super) use crate::test_rng::Rng;
@@ -369,6 +369,80 @@ fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
             assert_eq!(run(k), scalar, "{k:?} {ray:?}");
         }
     }
+}
+
+#[test]
+fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind() {
+    use super::wide::{intersect_many_with, Kernel};
+    let mesh = soup(4000, 41);
+    let opaque = Opaque(&mesh);
+    let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+    let without = Bvh::build_sah(&opaque, &BvhParams::default());
+    let mut kernels = vec![Kernel::Scalar];
+    if cfg!(target_arch = "x86_64") {
+        kernels.push(Kernel::Sse);
+    }
+    if Kernel::detect() == Kernel::Avx2 {
+        kernels.push(Kernel::Avx2);
+    }
+    // Random rays with rays that trivially miss mixed in (NaN origin, zero direction, t_max of zero,
+    // negative or NaN), so that slots are refilled past them, and short t_max that end rays early.
+    let mut batch: Vec<(Ray, f32)> = rays(1500, 3).into_iter().map(|r| (r, 30.0)).collect();
+    for k in (0..batch.len()).step_by(7) {
+        batch[k] = match k % 5 {
+            0 => (Ray::new(Vec3::NAN, Vec3::X), 30.0),
+            1 => (Ray::new(Vec3::ZERO, Vec3::ZERO), 30.0),
+            2 => (batch[k].0, 0.0),
+            3 => (batch[k].0, f32::NAN),
+            _ => (batch[k].0, 0.5),
+        };
+    }
+    batch.push((batch[1].0, -1.0));
+    let (rays, t_max): (Vec<Ray>, Vec<f32>) = batch.iter().copied().unzip();
+    let single: Vec<Option<Hit>> = batch.iter().map(|(r, t)| with_copy.intersect(&mesh, r, *t)).collect();
+    assert!(single.iter().filter(|h| h.is_some()).count() > 300, "the rays must hit");
+    for &k in &kernels {
+        // Every batch size up to 5 (one or both slots, refilled or not), then the rest at once.
+        for n in (0..=5).chain([rays.len()]) {
+            let mut out = vec![Some(Hit::new(u32::MAX, PrimHit::new(1.0, 0.0, 0.0))); n];
+            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
+            unsafe {
+                intersect_many_with(
+                    k,
+                    &with_copy.wide,
+                    &with_copy.prim_indices,
+                    &mesh,
+                    &rays[..n],
+                    &t_max[..n],
+                    &mut out,
+                )
+            };
+            assert_eq!(out, single[..n], "{k:?} mesh leaves, batch of {n}");
+            let mut out = vec![None; n];
+            // SAFETY: as above.
+            unsafe {
+                intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out)
+            };
+            assert_eq!(out, single[..n], "{k:?} primitive leaves, batch of {n}");
+        }
+    }
+    // Through the trait, and on an empty tree.
+    let mut out = vec![None; rays.len()];
+    with_copy.intersect_many(&mesh, &rays, &t_max, &mut out);
+    assert_eq!(out, single);
+    let empty = TriangleMesh::default();
+    let bvh = Bvh::build_sah(&empty, &BvhParams::default());
+    let mut out = vec![Some(Hit::new(0, PrimHit::new(1.0, 0.0, 0.0))); 3];
+    bvh.intersect_many(&empty, &rays[..3], &t_max[..3], &mut out);
+    assert_eq!(out, [None, None, None]);
+}
+
+#[test]
+#[should_panic(expected = "differ in length")]
+fn bvh_batch_of_mismatched_lengths_panics() {
+    let mesh = soup(10, 1);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    bvh.intersect_many(&mesh, &rays(3, 1), &[1.0; 2], &mut [None; 3]);
 }
 
 #[test]

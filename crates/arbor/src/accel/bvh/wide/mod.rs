@@ -26,9 +26,9 @@
 
 mod traverse;
 
-pub(super) use traverse::{intersect, occluded};
+pub(super) use traverse::{intersect, intersect_many, occluded};
 #[cfg(test)]
-pub(super) use traverse::{intersect_with, Kernel};
+pub(super) use traverse::{intersect_many_with, intersect_with, Kernel};
 
 use super::Node;
 use crate::accel::Primitives;

@@ -8,6 +8,11 @@
 //! All three compute the same per-lane arithmetic, so they visit the same nodes (unit test). The stack
 //! lives in uninitialised memory so that a query does not pay for clearing it.
 //!
+//! A batch of closest-hit queries ([`intersect_many`]) runs the same traversal for two rays at once,
+//! one node visit of each in turn ([`Walk`]): a visit is a chain of dependent loads and arithmetic, and
+//! the other ray's visit fills the wait. The node visit and the pop are shared by both forms
+//! ([`visit`], [`pop`]), so they visit the same nodes.
+//!
 //! Exactness against brute force follows the binary traversal (`../traverse.rs`), whose argument holds
 //! lane by lane: the box test is the same conservative test, `near <= far + scale * SLACK` with `scale`
 //! the larger slab distance on the ray's major axis; `max`/`min` take the accumulator as the operand
@@ -480,73 +485,307 @@ fn query<L: Leaves, const COUNT: bool, const K: u8>(
     let mut cur = root;
     loop {
         if cur.count == 0 {
-            let node = &nodes[cur.child as usize];
             if COUNT {
                 counts.nodes += 1;
             }
-            let (mask, near, slack) = lanes.test::<K>(node, best.t_far);
-            if mask != 0 {
-                let first = mask.trailing_zeros() as usize;
-                let rest = mask & (mask - 1);
-                if rest == 0 {
-                    cur = Ref { child: node.child[first], count: node.count[first] };
-                    prefetch(nodes, leaves, cur);
-                    continue;
-                }
-                if rest & (rest - 1) == 0 {
-                    // Two children, the common case: continue with the nearer, push the other.
-                    let second = rest.trailing_zeros() as usize;
-                    let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
-                    let r = Ref { child: node.child[push], count: node.count[push] };
-                    stack[sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
-                    sp += 1;
-                    prefetch(nodes, leaves, r);
-                    cur = Ref { child: node.child[go], count: node.count[go] };
-                    prefetch(nodes, leaves, cur);
-                    continue;
-                }
-                // Three to eight children: push them all, sort the pushed entries so that the nearest is on
-                // top (farthest deepest), and continue with the nearest.
-                let base = sp;
-                let mut m = mask;
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let e =
-                        Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
-                    // Insertion by decreasing `near`.
-                    let mut j = sp;
-                    // SAFETY: `base..sp` were written in this loop.
-                    while j > base && unsafe { stack[j - 1].assume_init_ref() }.near < e.near {
-                        stack[j] = stack[j - 1];
-                        j -= 1;
-                    }
-                    stack[j] = MaybeUninit::new(e);
-                    sp += 1;
-                    prefetch(nodes, leaves, e.r);
-                }
-                sp -= 1;
-                // SAFETY: written just above.
-                cur = unsafe { stack[sp].assume_init() }.r;
+            let node = &nodes[cur.child as usize];
+            if let Some(next) = visit::<L, K>(nodes, leaves, &lanes, node, best.t_far, &mut stack, &mut sp) {
+                cur = next;
                 continue;
             }
         } else {
             leaves.closest::<COUNT>(cur, &mut q, &mut best, counts);
         }
-        loop {
-            if sp == 0 {
-                return best.hit;
-            }
-            sp -= 1;
-            // SAFETY: entries below `sp` were written by the pushes above.
-            let e = unsafe { stack[sp].assume_init() };
-            // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(e.near > best.t_far + e.slack) {
-                cur = e.r;
-                break;
+        match pop(&stack, &mut sp, best.t_far) {
+            Some(next) => cur = next,
+            None => return best.hit,
+        }
+    }
+}
+
+/// One node visit: tests `node`'s eight boxes against `[0, t_far]`, pushes every child hit but the
+/// nearest (farthest deepest) and returns the nearest; `None` when no box is hit.
+#[inline(always)]
+fn visit<L: Leaves, const K: u8>(
+    nodes: &[Node8],
+    leaves: &L,
+    lanes: &Lanes,
+    node: &Node8,
+    t_far: f32,
+    stack: &mut [MaybeUninit<Entry>; STACK],
+    sp: &mut usize,
+) -> Option<Ref> {
+    let (mask, near, slack) = lanes.test::<K>(node, t_far);
+    if mask == 0 {
+        return None;
+    }
+    let first = mask.trailing_zeros() as usize;
+    let rest = mask & (mask - 1);
+    if rest == 0 {
+        let cur = Ref { child: node.child[first], count: node.count[first] };
+        prefetch(nodes, leaves, cur);
+        return Some(cur);
+    }
+    if rest & (rest - 1) == 0 {
+        // Two children, the common case: continue with the nearer, push the other.
+        let second = rest.trailing_zeros() as usize;
+        let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
+        let r = Ref { child: node.child[push], count: node.count[push] };
+        stack[*sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
+        *sp += 1;
+        prefetch(nodes, leaves, r);
+        let cur = Ref { child: node.child[go], count: node.count[go] };
+        prefetch(nodes, leaves, cur);
+        return Some(cur);
+    }
+    // Three to eight children: push them all, sort the pushed entries so that the nearest is on top
+    // (farthest deepest), and continue with the nearest.
+    let base = *sp;
+    let mut m = mask;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let e = Entry { r: Ref { child: node.child[l], count: node.count[l] }, near: near[l], slack: slack[l] };
+        // Insertion by decreasing `near`.
+        let mut j = *sp;
+        // SAFETY: `base..sp` were written in this loop.
+        while j > base && unsafe { stack[j - 1].assume_init_ref() }.near < e.near {
+            stack[j] = stack[j - 1];
+            j -= 1;
+        }
+        stack[j] = MaybeUninit::new(e);
+        *sp += 1;
+        prefetch(nodes, leaves, e.r);
+    }
+    *sp -= 1;
+    // SAFETY: written just above.
+    Some(unsafe { stack[*sp].assume_init() }.r)
+}
+
+/// Pops the nearest pushed child that may still hold a hit before `t_far`; `None` when none is left.
+#[inline(always)]
+fn pop(stack: &[MaybeUninit<Entry>; STACK], sp: &mut usize, t_far: f32) -> Option<Ref> {
+    while *sp > 0 {
+        *sp -= 1;
+        // SAFETY: entries below `sp` were written by `visit`.
+        let e = unsafe { stack[*sp].assume_init() };
+        // Negated so that a NaN (which cannot arise here) would keep the entry, not drop it.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(e.near > t_far + e.slack) {
+            return Some(e.r);
+        }
+    }
+    None
+}
+
+/// Closest-hit queries for a batch of rays, `out[i]` for `rays[i]` in `(0, t_max[i])`: the same hits as
+/// [`intersect`] ray by ray.
+///
+/// Two rays are traced at once, one node visit of each in turn (a finished ray's slot takes the
+/// batch's next ray): a node visit is a chain of dependent loads and arithmetic that one ray cannot
+/// overlap with its next visit, which depends on it, but the other ray's visit can fill that wait
+/// (measured in docs/performance.md). The counted query and the any-hit query stay one ray at a time.
+pub(in crate::accel::bvh) fn intersect_many<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    // SAFETY: `detect` gives a kernel this processor runs.
+    unsafe { intersect_many_with(Kernel::detect(), wide, indices, prims, rays, t_max, out) }
+}
+
+/// [`intersect_many`] with the given kernel.
+///
+/// # Safety
+/// The processor must support `kernel` (AVX2 for [`Kernel::Avx2`]).
+pub(in crate::accel::bvh) unsafe fn intersect_many_with<P: Primitives + ?Sized>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and hits differ in length");
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the caller vouches for AVX2.
+        Kernel::Avx2 => unsafe { many_avx2(wide, indices, prims, rays, t_max, out) },
+        Kernel::Sse if cfg!(target_arch = "x86_64") => many_kernel::<P, SSE>(wide, indices, prims, rays, t_max, out),
+        _ => many_kernel::<P, SCALAR>(wide, indices, prims, rays, t_max, out),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn many_avx2<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    many_kernel::<P, AVX2>(wide, indices, prims, rays, t_max, out)
+}
+
+#[inline(always)]
+fn many_kernel<P: Primitives + ?Sized, const K: u8>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    let Some(root) = wide.root else {
+        out.fill(None);
+        return;
+    };
+    match &wide.blocks {
+        Some(blocks) => many::<_, K>(&wide.nodes, &MeshLeaves { blocks }, root, rays, t_max, out),
+        None => many::<_, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, rays, t_max, out),
+    }
+}
+
+/// The interleaved closest-hit traversals of a batch, from `root`: two rays at once. (Three or four
+/// at once were slower: their states no longer fit the registers. The two slots are named rather than
+/// an array, 1-2% faster.)
+#[inline(always)]
+fn many<L: Leaves, const K: u8>(
+    nodes: &[Node8],
+    leaves: &L,
+    root: Ref,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    let mut next = 0;
+    let Some(i) = next_ray(rays, t_max, out, &mut next) else { return };
+    let (mut ia, mut a) = (i, Walk::new(root, &rays[i], t_max[i]));
+    let Some(i) = next_ray(rays, t_max, out, &mut next) else {
+        out[ia] = a.finish::<L, K>(nodes, leaves);
+        return;
+    };
+    let (mut ib, mut b) = (i, Walk::new(root, &rays[i], t_max[i]));
+    // Both slots busy: step each in turn; a finished one takes the next ray, until none is left.
+    loop {
+        a.step::<L, K>(nodes, leaves);
+        b.step::<L, K>(nodes, leaves);
+        if a.done {
+            out[ia] = a.best.hit;
+            match next_ray(rays, t_max, out, &mut next) {
+                Some(i) => {
+                    ia = i;
+                    a.restart(root, &rays[i], t_max[i]);
+                }
+                None => {
+                    out[ib] = b.finish::<L, K>(nodes, leaves);
+                    return;
+                }
             }
         }
+        if b.done {
+            out[ib] = b.best.hit;
+            match next_ray(rays, t_max, out, &mut next) {
+                Some(i) => {
+                    ib = i;
+                    b.restart(root, &rays[i], t_max[i]);
+                }
+                None => {
+                    out[ia] = a.finish::<L, K>(nodes, leaves);
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// The index of the batch's next ray from `*next` on that needs a traversal; the rays skipped on the
+/// way trivially miss and get `None`.
+#[inline(always)]
+fn next_ray(rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>], next: &mut usize) -> Option<usize> {
+    while *next < rays.len() {
+        let i = *next;
+        *next += 1;
+        if !trivially_misses(&rays[i], t_max[i]) {
+            return Some(i);
+        }
+        out[i] = None;
+    }
+    None
+}
+
+/// One ray's closest-hit traversal as a state advanced one step at a time: a node visit, or a leaf and
+/// the pops after it. [`query`] is the same traversal run to its end in one loop, which keeps its state
+/// in registers.
+struct Walk<'r> {
+    lanes: Lanes,
+    q: LeafRay<'r>,
+    best: Best,
+    stack: [MaybeUninit<Entry>; STACK],
+    sp: usize,
+    cur: Ref,
+    done: bool,
+}
+
+impl<'r> Walk<'r> {
+    #[inline(always)]
+    fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
+        let lanes = Lanes::new(ray);
+        let major = lanes.major;
+        Walk {
+            lanes,
+            q: LeafRay { ray, major, frame: None },
+            best: Best { hit: None, t_far: t_max, t_query: t_max },
+            stack: [const { MaybeUninit::<Entry>::uninit() }; STACK],
+            sp: 0,
+            cur: root,
+            done: false,
+        }
+    }
+
+    /// Starts over with another ray (in place: the stack is not moved).
+    #[inline(always)]
+    fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
+        self.lanes = Lanes::new(ray);
+        self.q = LeafRay { ray, major: self.lanes.major, frame: None };
+        self.best = Best { hit: None, t_far: t_max, t_query: t_max };
+        self.sp = 0;
+        self.cur = root;
+        self.done = false;
+    }
+
+    #[inline(always)]
+    fn step<L: Leaves, const K: u8>(&mut self, nodes: &[Node8], leaves: &L) {
+        if self.cur.count == 0 {
+            let node = &nodes[self.cur.child as usize];
+            if let Some(next) =
+                visit::<L, K>(nodes, leaves, &self.lanes, node, self.best.t_far, &mut self.stack, &mut self.sp)
+            {
+                self.cur = next;
+                return;
+            }
+        } else {
+            leaves.closest::<false>(self.cur, &mut self.q, &mut self.best, &mut TraversalCounts::default());
+        }
+        match pop(&self.stack, &mut self.sp, self.best.t_far) {
+            Some(next) => self.cur = next,
+            None => self.done = true,
+        }
+    }
+
+    /// Runs the traversal to its end and returns its hit.
+    #[inline(always)]
+    fn finish<L: Leaves, const K: u8>(&mut self, nodes: &[Node8], leaves: &L) -> Option<Hit> {
+        while !self.done {
+            self.step::<L, K>(nodes, leaves);
+        }
+        self.best.hit
     }
 }
 
