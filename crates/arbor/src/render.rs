@@ -28,6 +28,9 @@ use crate::sampler::{pixel_offset, Rng};
 use crate::scene::Scene;
 
 const TILE: u32 = 16;
+/// Camera rays traced as one batch (at least one pixel's samples): enough for the BVH's interleaved
+/// traversal to stay busy, few enough that a tile's batch stays in cache.
+const BATCH: usize = 256;
 
 /// Choices made for one render, on top of what the scene says.
 #[derive(Debug, Clone, Default)]
@@ -188,19 +191,39 @@ fn trace(
         .map(|&(x0, y0, x1, y1)| {
             let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             let mut count = 0u64;
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let mut sum = SampleSum::default();
+            let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
+            // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
+            let per_batch = (BATCH / (k1 - k0) as usize).max(1);
+            let (mut batch, mut rngs, mut hits) = (Vec::new(), Vec::new(), Vec::new());
+            for group in tile.chunks(per_batch) {
+                batch.clear();
+                rngs.clear();
+                for &(x, y) in group {
                     for k in k0..k1 {
                         let mut rng = Rng::for_sample(x, y, k);
                         let offset = pixel_offset(k, spp, &mut rng);
                         let ray = cam.ray(x, y, offset, rng.next_2d());
+                        batch.push(match &debug {
+                            Some(_) => ray,
+                            None => integrator.camera_ray(&ray),
+                        });
+                        rngs.push(rng);
+                    }
+                }
+                if debug.is_none() {
+                    hits.resize(batch.len(), None);
+                    scene.geometry.intersect_many(&batch, f32::INFINITY, &mut hits);
+                }
+                let samples = (k1 - k0) as usize;
+                for p in 0..group.len() {
+                    let mut sum = SampleSum::default();
+                    for s in p * samples..(p + 1) * samples {
                         sum.add_sample(match &debug {
                             Some(d) => {
                                 count += 1;
-                                d.li_camera(&ray)
+                                d.li_camera(&batch[s])
                             }
-                            None => integrator.li_camera(&ray, &mut rng, &mut count),
+                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut rngs[s], &mut count),
                         });
                     }
                     pixels.push(sum);

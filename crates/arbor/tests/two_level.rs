@@ -167,3 +167,35 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
     assert!(total > 1_000, "too few hits to compare: {total}");
     assert!(agree as f64 >= 0.999 * total as f64, "{agree} of {total} hits on the same primitive");
 }
+
+#[test]
+fn two_level_batches_give_every_ray_its_own_querys_hit() {
+    // One transformed mesh with a plane beside it (the batch goes through the mesh's structure), and a
+    // random scene of many objects (each ray walks the top level); invalid rays mixed in.
+    let mut rng = Lcg(23);
+    let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
+    let indices: Vec<[u32; 3]> = (0..200).map(|k| [k * 3 % 300, (k * 3 + 1) % 300, (k * 3 + 2) % 300]).collect();
+    let mesh = Arc::new(TriangleMesh { positions, indices, ..Default::default() });
+    let t = Transform::translate(Vec3::new(1.0, 2.0, 0.5)).then(&Transform::rotate(30.0, Vec3::Y).unwrap());
+    let one_mesh = desc(vec![
+        object("Mesh", ShapeDesc::Mesh { source: MeshSource::Inline(mesh), smooth: false }, t),
+        object("Plane", ShapeDesc::Plane { point: Vec3::new(0.0, -1.5, 0.0), normal: Vec3::Y }, Transform::IDENTITY),
+    ]);
+    for d in [one_mesh, random_scene(&mut rng)] {
+        let mut rays: Vec<Ray> = (0..3_000).map(|_| Ray::new(rng.v(30.0), rng.v(2.0))).collect();
+        rays[10] = Ray::new(Vec3::NAN, Vec3::X);
+        rays[11] = Ray::new(Vec3::ZERO, Vec3::ZERO);
+        for &kind in AccelKind::ALL {
+            let g = build_geometry(&d, &AccelSpec::new(kind)).unwrap();
+            for t_max in [f32::INFINITY, 20.0] {
+                let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
+                assert!(single.iter().filter(|h| h.is_some()).count() > 200, "{kind}: the rays must hit");
+                for n in [0, 1, 2, 3, rays.len()] {
+                    let mut out = vec![None; n];
+                    g.intersect_many(&rays[..n], t_max, &mut out);
+                    assert_eq!(out, single[..n], "{kind}, t_max {t_max}, batch of {n}");
+                }
+            }
+        }
+    }
+}

@@ -8,6 +8,7 @@
 //! bound ([`super::offset::spawn_origin`] decides).
 
 use super::offset::spawn_origin;
+use crate::accel::Hit;
 use crate::light::sample_light;
 use crate::material::{beer, blinn_phong, specular_lobes};
 use crate::math::{Color, Ray};
@@ -28,15 +29,45 @@ impl<'a> Whitted<'a> {
 
     /// Radiance (in the scene's units) along a camera ray.
     pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, count: &mut u64) -> Color {
-        self.li(&ray.with_culling(self.cull_backfaces), 0, None, rng, count)
+        let ray = self.camera_ray(ray);
+        *count += 1;
+        let hit = self.scene.geometry.intersect(&ray, f32::INFINITY);
+        self.shade(&ray, hit, 0, None, rng, count)
+    }
+
+    /// The camera ray as it is traced: culling back faces if the render asks for it.
+    pub fn camera_ray(&self, ray: &Ray) -> Ray {
+        ray.with_culling(self.cull_backfaces)
+    }
+
+    /// [`Whitted::li_camera`] for a camera ray already traced (with others, by
+    /// [`crate::scene::SceneGeometry::intersect_many`]): `ray` is [`Whitted::camera_ray`]'s and `hit` its
+    /// closest hit.
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
+        *count += 1;
+        self.shade(ray, hit, 0, None, rng, count)
     }
 
     /// Radiance along `ray` at recursion `depth`; `inside` is the absorption of the glass the ray travels
     /// in, if any.
     fn li(&self, ray: &Ray, depth: u32, inside: Option<Color>, rng: &mut Rng, count: &mut u64) -> Color {
-        let scene = self.scene;
         *count += 1;
-        let Some(hit) = scene.geometry.intersect(ray, f32::INFINITY) else {
+        let hit = self.scene.geometry.intersect(ray, f32::INFINITY);
+        self.shade(ray, hit, depth, inside, rng, count)
+    }
+
+    /// Radiance along `ray` at recursion `depth` given its closest hit.
+    fn shade(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        depth: u32,
+        inside: Option<Color>,
+        rng: &mut Rng,
+        count: &mut u64,
+    ) -> Color {
+        let scene = self.scene;
+        let Some(hit) = hit else {
             return self.miss(ray, depth);
         };
         let s = scene.surface(ray, &hit);

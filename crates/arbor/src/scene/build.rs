@@ -159,6 +159,42 @@ impl SceneGeometry {
         self.intersect_planes(ray, t_max, best, None)
     }
 
+    /// [`SceneGeometry::intersect`] for a batch (the camera rays of a few pixels): `out[i]` becomes
+    /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query. When the bounded geometry is one
+    /// mesh, the batch goes through that mesh's structure at once ([`Accel::intersect_many`], which
+    /// the BVH traces two rays at a time); otherwise each ray walks the top level on its own.
+    ///
+    /// # Panics
+    /// When `rays` and `out` differ in length.
+    pub fn intersect_many(&self, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
+        let single_mesh = match self.objects.objects.as_slice() {
+            [o] => match &o.shape {
+                Shape::Mesh(m) => Some((o, m)),
+                Shape::Sphere(_) => None,
+            },
+            _ => None,
+        };
+        let Some((object, mesh)) = single_mesh else {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = self.intersect(r, t_max);
+            }
+            return;
+        };
+        // An invalid ray hits nothing, planes included, as in `intersect`; the mesh's structure
+        // already answers it with no hit.
+        let local: Vec<Ray> = rays.iter().map(|r| object.local_ray(r)).collect();
+        mesh.accel.intersect_many(&mesh.mesh, &local, &vec![t_max; rays.len()], out);
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = if r.is_valid() {
+                let best = o.map(|h| Hit::new(0, nested(h)));
+                self.intersect_planes(r, t_max, best, None)
+            } else {
+                None
+            };
+        }
+    }
+
     /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested at both levels to
     /// `counts` (the traversal-cost heatmap).
     pub fn intersect_counted(&self, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
