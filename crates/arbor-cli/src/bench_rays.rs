@@ -6,6 +6,10 @@
 //! median of `--runs` builds of the mesh (wall time from the loaded mesh to a traceable structure);
 //! each ray set traced at least 3 times and for at least 0.3 s (stopping after 2.5 s), median rate.
 //! One thread traces on the calling thread; more threads trace 1024-ray chunks on the rayon pool.
+//!
+//! Every structure is traced twice: one query per ray (`peer=arbor-KIND`, as peerbench calls Embree's
+//! `rtcIntersect1`), and whole batches through [`Accel::intersect_many`] (`peer=arbor-KIND-batch`, the
+//! BVH interleaving two rays; the renderer traces its camera rays so).
 //! `mismatch` is the share of rays whose hit disagrees with the reference peer's (hit or miss, or `t`
 //! off by more than 1e-4 relative, see [`disagrees`]).
 //!
@@ -16,10 +20,11 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use arbor::accel::{build_with, Accel, AccelSpec};
-use arbor::bench::ray_files::{disagrees, load_ray_set, FileRay, RaySetFile};
+use arbor::accel::{build_with, Accel, AccelSpec, Hit};
+use arbor::bench::ray_files::{disagrees, load_ray_set, RaySetFile};
 use arbor::bench::sphere_mesh;
 use arbor::geometry::TriangleMesh;
+use arbor::math::Ray;
 use rayon::prelude::*;
 
 use crate::bench::BenchArgs;
@@ -50,6 +55,13 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
         bytes as f64 / load.as_secs_f64().max(1e-9) / 1e6
     );
     let sets = [load_ray_set(dir, "primary")?, load_ray_set(dir, "diffuse")?];
+    let batches: Vec<Batch> = sets
+        .iter()
+        .map(|s| Batch {
+            rays: s.rays.iter().map(|r| r.ray).collect(),
+            t_max: s.rays.iter().map(|r| r.t_max).collect(),
+        })
+        .collect();
     let warm_up = sphere_mesh(2000);
     for spec in kinds {
         drop(build_with(spec, &warm_up).map_err(arbor::Error::Invalid)?);
@@ -69,22 +81,26 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
         let cpu_build_ms = median(&mut cpu_builds);
         let list: Vec<String> = builds.iter().map(|b| format!("{b:.1}")).collect();
         say!("# peer=arbor-{} built in {} ms", spec.kind, list.join(", "));
-        for set in &sets {
-            let r = measure(accel.as_ref(), &mesh, set, threads);
-            say!(
-                "peer=arbor-{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} tris={} \
-                 rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} cpu_mrays={:.3}",
-                spec.kind,
-                set.name,
-                r.mrays,
-                r.hits,
-                path.file_name().map_or_else(|| args.input.clone(), |f| f.to_string_lossy().into_owned()),
-                mesh.len(),
-                set.rays.len(),
-                r.runs,
-                r.mismatch,
-                r.cpu_mrays
-            );
+        for (set, batch) in sets.iter().zip(&batches) {
+            for mode in [Mode::Single, Mode::Batch] {
+                let r = measure(accel.as_ref(), &mesh, set, batch, threads, mode);
+                say!(
+                    "peer=arbor-{}{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} \
+                     tris={} rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} \
+                     cpu_mrays={:.3}",
+                    spec.kind,
+                    mode.suffix(),
+                    set.name,
+                    r.mrays,
+                    r.hits,
+                    path.file_name().map_or_else(|| args.input.clone(), |f| f.to_string_lossy().into_owned()),
+                    mesh.len(),
+                    set.rays.len(),
+                    r.runs,
+                    r.mismatch,
+                    r.cpu_mrays
+                );
+            }
         }
     }
     Ok(())
@@ -98,55 +114,88 @@ struct Measured {
     mismatch: f64,
 }
 
-fn measure(accel: &dyn Accel<TriangleMesh>, mesh: &TriangleMesh, set: &RaySetFile, threads: usize) -> Measured {
-    let trace = |out: &mut Vec<Option<f32>>| {
-        let (start, cpu) = (Instant::now(), cpu_time());
-        trace_all(accel, mesh, &set.rays, threads, out);
-        (start.elapsed(), cpu_time() - cpu)
-    };
-    let mut ts = vec![None; set.rays.len()];
+/// How the rays are handed to the structure.
+#[derive(Clone, Copy)]
+enum Mode {
+    /// One [`Accel::intersect`] per ray.
+    Single,
+    /// [`Accel::intersect_many`] over the whole set (one thread) or each chunk.
+    Batch,
+}
+
+impl Mode {
+    fn suffix(self) -> &'static str {
+        match self {
+            Mode::Single => "",
+            Mode::Batch => "-batch",
+        }
+    }
+}
+
+/// A ray set as the batch query takes it, built before timing.
+struct Batch {
+    rays: Vec<Ray>,
+    t_max: Vec<f32>,
+}
+
+fn measure(
+    accel: &dyn Accel<TriangleMesh>,
+    mesh: &TriangleMesh,
+    set: &RaySetFile,
+    batch: &Batch,
+    threads: usize,
+    mode: Mode,
+) -> Measured {
+    let mut hits = vec![None; set.rays.len()];
     let mut times = Vec::new();
     let mut cpu_times = Vec::new();
     let mut total = Duration::ZERO;
     while times.len() < MIN_RUNS || total < MIN_TIME {
-        let (dt, cpu) = trace(&mut ts);
+        let (start, cpu) = (Instant::now(), cpu_time());
+        trace_all(accel, mesh, batch, threads, mode, &mut hits);
+        let dt = start.elapsed();
         total += dt;
         times.push(dt.as_secs_f64());
-        cpu_times.push(cpu.as_secs_f64());
+        cpu_times.push((cpu_time() - cpu).as_secs_f64());
         if total > MAX_TIME {
             break;
         }
     }
     let secs = median(&mut times).max(1e-9);
-    let wrong = ts.iter().zip(&set.hits).filter(|(t, r)| disagrees(**t, r)).count();
+    let wrong = hits.iter().zip(&set.hits).filter(|(h, r)| disagrees(h.map(|h| h.t), r)).count();
     Measured {
         mrays: set.rays.len() as f64 / secs / 1e6,
         cpu_mrays: set.rays.len() as f64 / median(&mut cpu_times).max(1e-9) / 1e6,
-        hits: ts.iter().flatten().count(),
+        hits: hits.iter().flatten().count(),
         runs: times.len(),
         mismatch: wrong as f64 / set.rays.len().max(1) as f64,
     }
 }
 
-/// Closest-hit distances of `rays` into `out`: on this thread for one thread, else in chunks on rayon.
+/// Closest hits of the batch into `out`: on this thread for one thread, else in chunks on rayon.
 fn trace_all(
     accel: &dyn Accel<TriangleMesh>,
     mesh: &TriangleMesh,
-    rays: &[FileRay],
+    batch: &Batch,
     threads: usize,
-    out: &mut [Option<f32>],
+    mode: Mode,
+    out: &mut [Option<Hit>],
 ) {
-    let one = |r: &FileRay| accel.intersect(mesh, &r.ray, r.t_max).map(|h| h.t);
-    if threads == 1 {
-        for (o, r) in out.iter_mut().zip(rays) {
-            *o = one(r);
-        }
-    } else {
-        out.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(o, r)| {
-            for (o, r) in o.iter_mut().zip(r) {
-                *o = one(r);
+    let trace = |rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]| match mode {
+        Mode::Single => {
+            for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
+                *o = accel.intersect(mesh, r, t);
             }
-        });
+        }
+        Mode::Batch => accel.intersect_many(mesh, rays, t_max, out),
+    };
+    if threads == 1 {
+        trace(&batch.rays, &batch.t_max, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .zip(batch.rays.par_chunks(CHUNK))
+            .zip(batch.t_max.par_chunks(CHUNK))
+            .for_each(|((o, r), t)| trace(r, t, o));
     }
 }
 

@@ -119,10 +119,12 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("peer=")).collect();
-    assert_eq!(lines.len(), 2, "{out}");
-    for (line, set) in lines.iter().zip(["primary", "diffuse"]) {
+    assert_eq!(lines.len(), 4, "{out}");
+    let expected = [("", "primary"), ("-batch", "primary"), ("", "diffuse"), ("-batch", "diffuse")];
+    for (line, (mode, set)) in lines.iter().zip(expected) {
         let fields: Vec<&str> = line.split_whitespace().collect();
-        assert_eq!(fields[..3], ["peer=arbor-bvh-sah", &format!("set={set}")[..], "threads=1"], "{line}");
+        let peer = format!("peer=arbor-bvh-sah{mode}");
+        assert_eq!(fields[..3], [&peer[..], &format!("set={set}")[..], "threads=1"], "{line}");
         assert!(fields[3].starts_with("build_ms=") && fields[4].starts_with("mrays="), "{line}");
         assert_eq!(fields[5], "hits=2", "{line}");
         assert!(line.contains("mismatch=0.333333"), "{line}");

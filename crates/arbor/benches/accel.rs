@@ -1,9 +1,9 @@
 //! Build and traversal speed of every acceleration structure (criterion), on two interpenetrating
 //! generated spheres of 10,000 triangles each (so that diffuse bounces hit something) seen by the
 //! benchmark camera (`arbor::bench`): primary rays through 128x128 pixel centres, then one diffuse
-//! bounce from each hit. Small on purpose, so that `cargo bench` takes a
-//! couple of minutes; `arbor bench` and `scripts/peer-compare.sh` measure the large meshes and the
-//! peers (see `docs/performance.md`). Brute force is left out: at 20,000 tests per ray it would
+//! bounce from each hit, traced one query per ray and as one batch. Small on purpose, so that `cargo
+//! bench` takes a couple of minutes; `arbor bench` and `scripts/peer-compare.sh` measure the large
+//! meshes and the peers (see `docs/performance.md`). Brute force is left out: at 20,000 tests per ray it would
 //! dominate the run and says nothing new.
 //!
 //! Throughput is reported in rays (traversal) and triangles (build) per second.
@@ -66,6 +66,21 @@ fn traverse(c: &mut Criterion) {
             let accel = build_with(&AccelSpec::new(kind), &mesh).expect("default parameters");
             g.bench_function(BenchmarkId::from_parameter(kind), |b| {
                 b.iter(|| rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count())
+            });
+        }
+        g.finish();
+        // The same rays as one batch (`intersect_many`: the BVH interleaves two rays).
+        let mut g = c.benchmark_group(format!("intersect-many-{set}"));
+        g.sample_size(10).throughput(Throughput::Elements(rays.len() as u64));
+        let t_max = vec![f32::INFINITY; rays.len()];
+        let mut hits = vec![None; rays.len()];
+        for kind in kinds() {
+            let accel = build_with(&AccelSpec::new(kind), &mesh).expect("default parameters");
+            g.bench_function(BenchmarkId::from_parameter(kind), |b| {
+                b.iter(|| {
+                    accel.intersect_many(&mesh, rays, &t_max, &mut hits);
+                    hits.iter().filter(|h| h.is_some()).count()
+                })
             });
         }
         g.finish();
