@@ -490,7 +490,7 @@ fn query<L: Leaves, const COUNT: bool, const K: u8>(
                 counts.nodes += 1;
             }
             let node = &nodes[cur.child as usize];
-            if let Some(next) = visit::<L, K>(nodes, leaves, &lanes, node, best.t_far, &mut stack, &mut sp) {
+            if let Some(next) = visit::<L, K, false>(nodes, leaves, &lanes, node, best.t_far, &mut stack, &mut sp) {
                 cur = next;
                 continue;
             }
@@ -506,8 +506,12 @@ fn query<L: Leaves, const COUNT: bool, const K: u8>(
 
 /// One node visit: tests `node`'s eight boxes against `[0, t_far]`, pushes every child hit but the
 /// nearest (farthest deepest) and returns the nearest; `None` when no box is hit.
+///
+/// `MERGED` handles one and two children in one path without a branch on which. The batch takes it:
+/// a mispredicted branch there throws away both rays' work in flight (batches +1-6%). A single query
+/// does not: it was 3-8% slower, as the always-written entry and second prefetch lengthen its chain.
 #[inline(always)]
-fn visit<L: Leaves, const K: u8>(
+fn visit<L: Leaves, const K: u8, const MERGED: bool>(
     nodes: &[Node8],
     leaves: &L,
     lanes: &Lanes,
@@ -522,6 +526,20 @@ fn visit<L: Leaves, const K: u8>(
     }
     let first = mask.trailing_zeros() as usize;
     let rest = mask & (mask - 1);
+    if MERGED && rest & rest.wrapping_sub(1) == 0 {
+        // One or two children, without a branch on which: continue with the nearer and push the other
+        // (with one child, `second` is `first` and the entry written is not kept).
+        let two = rest != 0;
+        let second = std::hint::select_unpredictable(two, rest.trailing_zeros() as usize, first);
+        let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
+        let r = Ref { child: node.child[push], count: node.count[push] };
+        stack[*sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
+        *sp += two as usize;
+        prefetch(nodes, leaves, r);
+        let cur = Ref { child: node.child[go], count: node.count[go] };
+        prefetch(nodes, leaves, cur);
+        return Some(cur);
+    }
     if rest == 0 {
         let cur = Ref { child: node.child[first], count: node.count[first] };
         prefetch(nodes, leaves, cur);
@@ -766,7 +784,7 @@ impl<'r> Walk<'r> {
         if self.cur.count == 0 {
             let node = &nodes[self.cur.child as usize];
             if let Some(next) =
-                visit::<L, K>(nodes, leaves, &self.lanes, node, self.best.t_far, &mut self.stack, &mut self.sp)
+                visit::<L, K, true>(nodes, leaves, &self.lanes, node, self.best.t_far, &mut self.stack, &mut self.sp)
             {
                 self.cur = next;
                 return;
