@@ -170,8 +170,8 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
 
 #[test]
 fn two_level_batches_give_every_ray_its_own_querys_hit() {
-    // One transformed mesh with a plane beside it (the batch goes through the mesh's structure), and a
-    // random scene of many objects (each ray walks the top level); invalid rays mixed in.
+    // One transformed mesh with a plane beside it, a few objects, and a random scene of more objects
+    // than are swept (each ray walks the top level); invalid rays mixed in.
     let mut rng = Lcg(23);
     let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
     let indices: Vec<[u32; 3]> = (0..200).map(|k| [k * 3 % 300, (k * 3 + 1) % 300, (k * 3 + 2) % 300]).collect();
@@ -181,8 +181,21 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         object("Mesh", ShapeDesc::Mesh { source: MeshSource::Inline(mesh), smooth: false }, t),
         object("Plane", ShapeDesc::Plane { point: Vec3::new(0.0, -1.5, 0.0), normal: Vec3::Y }, Transform::IDENTITY),
     ]);
-    for d in [one_mesh, random_scene(&mut rng)] {
-        let mut rays: Vec<Ray> = (0..3_000).map(|_| Ray::new(rng.v(30.0), rng.v(2.0))).collect();
+    // Few objects (swept object by object): meshes, instances and spheres, plus an instance in the very
+    // place of the first mesh, whose hits tie with it and must go to the first.
+    let mut few = random_scene(&mut rng);
+    few.objects.truncate(6);
+    let same_place = few.objects[0].transform;
+    few.objects.push(object("MeshInstance", ShapeDesc::Instance { base: 0 }, same_place));
+    assert!(few.objects.len() <= arbor::scene::SWEEP_OBJECTS);
+    for d in [one_mesh, few, random_scene(&mut rng)] {
+        // Aimed at the middle of the scene, where its objects are.
+        let mut rays: Vec<Ray> = (0..3_000)
+            .map(|_| {
+                let o = rng.v(30.0);
+                Ray::new(o, rng.v(12.0) - o)
+            })
+            .collect();
         rays[10] = Ray::new(Vec3::NAN, Vec3::X);
         rays[11] = Ray::new(Vec3::ZERO, Vec3::ZERO);
         for &kind in AccelKind::ALL {

@@ -23,6 +23,11 @@ use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::{Error, Result};
 
+/// Scenes of at most this many bounded objects trace batches object by object
+/// ([`SceneGeometry::intersect_many`]): up to one wide node's fan-out, what a ray pays for meeting every
+/// object's root is about what a walk of the top level costs it.
+pub const SWEEP_OBJECTS: usize = 8;
+
 /// A mesh in object space under its own structure; shared by every object that shows it.
 pub struct MeshShape {
     /// Triangles in object space; `normals` are set for smooth shading only.
@@ -160,38 +165,55 @@ impl SceneGeometry {
     }
 
     /// [`SceneGeometry::intersect`] for a batch (the camera rays of a few pixels): `out[i]` becomes
-    /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query. When the bounded geometry is one
-    /// mesh, the batch goes through that mesh's structure at once ([`Accel::intersect_many`], which
-    /// the BVH traces two rays at a time); otherwise each ray walks the top level on its own.
+    /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
+    ///
+    /// A scene of at most [`SWEEP_OBJECTS`] bounded objects is swept object by object, each mesh
+    /// tracing the whole batch at once ([`Accel::intersect_many`], which the BVH traces two rays at a
+    /// time) up to the closest hit found so far, which a later object must beat strictly: the smallest
+    /// `t` wins and ties go to the lowest object, as at the top level. Past that many objects, each ray
+    /// walks the top level on its own, which skips the objects it does not come near.
     ///
     /// # Panics
     /// When `rays` and `out` differ in length.
     pub fn intersect_many(&self, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
-        let single_mesh = match self.objects.objects.as_slice() {
-            [o] => match &o.shape {
-                Shape::Mesh(m) => Some((o, m)),
-                Shape::Sphere(_) => None,
-            },
-            _ => None,
-        };
-        let Some((object, mesh)) = single_mesh else {
+        let objects = &self.objects.objects;
+        if objects.len() > SWEEP_OBJECTS {
             for (o, r) in out.iter_mut().zip(rays) {
                 *o = self.intersect(r, t_max);
             }
             return;
-        };
-        // An invalid ray hits nothing, planes included, as in `intersect`; the mesh's structure
-        // already answers it with no hit.
-        let local: Vec<Ray> = rays.iter().map(|r| object.local_ray(r)).collect();
-        mesh.accel.intersect_many(&mesh.mesh, &local, &vec![t_max; rays.len()], out);
+        }
+        out.fill(None);
+        let mut limit = vec![t_max; rays.len()];
+        let (mut local, mut found) = (Vec::new(), Vec::new());
+        for (i, object) in objects.iter().enumerate() {
+            match &object.shape {
+                Shape::Mesh(m) => {
+                    local.clear();
+                    local.extend(rays.iter().map(|r| object.local_ray(r)));
+                    found.resize(rays.len(), None);
+                    m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
+                    for ((o, l), h) in out.iter_mut().zip(&mut limit).zip(&found) {
+                        if let Some(h) = h {
+                            *o = Some(Hit::new(i as u32, nested(*h)));
+                            *l = h.t;
+                        }
+                    }
+                }
+                Shape::Sphere(s) => {
+                    for ((o, l), r) in out.iter_mut().zip(&mut limit).zip(rays) {
+                        if let Some(t) = s.intersect(r, *l) {
+                            *o = Some(Hit::new(i as u32, PrimHit::new(t, 0.0, 0.0)));
+                            *l = t;
+                        }
+                    }
+                }
+            }
+        }
+        // An invalid ray hits nothing, planes included, as in `intersect`.
         for (o, r) in out.iter_mut().zip(rays) {
-            *o = if r.is_valid() {
-                let best = o.map(|h| Hit::new(0, nested(h)));
-                self.intersect_planes(r, t_max, best, None)
-            } else {
-                None
-            };
+            *o = if r.is_valid() { self.intersect_planes(r, t_max, *o, None) } else { None };
         }
     }
 

@@ -16,7 +16,9 @@ mod xml;
 
 use std::path::Path;
 
-pub use build::{build_geometry, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
+pub use build::{
+    build_geometry, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape, SWEEP_OBJECTS,
+};
 pub use desc::*;
 pub use limits::{check_limits, SceneLimits};
 pub use runtime::{Scene, Surface};
