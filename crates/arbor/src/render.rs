@@ -10,6 +10,11 @@
 //! A cancellation flag ([`RenderOptions::cancel`]) is checked before every tile: once set, the remaining
 //! tiles are skipped and the result is marked [`RenderStats::cancelled`] (it must not be written).
 //!
+//! Within a tile the camera rays of a few pixels (up to 256 samples) are traced as one batch
+//! ([`crate::scene::SceneGeometry::intersect_many`]: the BVH interleaves two rays), then shaded pixel by
+//! pixel; secondary and shadow rays are traced one at a time. Batches give the same hits as single
+//! queries, so the image does not depend on them either.
+//!
 //! A debug view ([`RenderOptions::debug`]) either replaces the Whitted integrator by one ray through each
 //! pixel centre ([`DebugIntegrator`]), or draws over the finished Whitted image (boxes).
 
