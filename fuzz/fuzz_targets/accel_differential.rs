@@ -6,7 +6,8 @@
 //! any f32 at all (NaN, infinities, huge, subnormal). Every kind of `AccelKind::ALL` is built with its
 //! default parameters (and validated: this target is built with debug assertions) and must answer
 //! exactly as brute force does: the same `Option`, the same primitive, the same `t` bits, the same
-//! `occluded`; and for a hit at `t`, `occluded` at `t` must be false.
+//! `occluded`; and for a hit at `t`, `occluded` at `t` must be false. The rays traced as one batch
+//! (`intersect_many`) must each get the hit of their own query.
 //!
 //! With `ARBOR_FUZZ_T_ABOVE=1` it also asks that `occluded` just above a hit's `t` be true. That check
 //! was off by default while a bug of `intersect_triangle` broke it (now fixed: the regression test
@@ -58,6 +59,11 @@ impl Input<'_> {
 static T_ABOVE: std::sync::LazyLock<bool> =
     std::sync::LazyLock::new(|| std::env::var_os("ARBOR_FUZZ_T_ABOVE").is_some_and(|v| v == "1"));
 
+/// A hit as bits, so that two identical hits compare equal even with a NaN in them.
+fn bits(h: &Option<Hit>) -> Option<(u32, u32, u32, u32, u32)> {
+    h.map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits(), h.sub))
+}
+
 fn same_hit(a: &Option<Hit>, b: &Option<Hit>) -> bool {
     match (a, b) {
         (None, None) => true,
@@ -107,6 +113,14 @@ fuzz_target!(|data: &[u8]| {
                     assert!(accel.occluded(&mesh, ray, above), "{kind}: {ray:?}: not occluded above the hit t {}", h.t);
                 }
             }
+        }
+        // All the rays as one batch: each must get the hit of its own query.
+        let (batch, t_max): (Vec<Ray>, Vec<f32>) = rays.iter().copied().unzip();
+        let mut got = vec![None; rays.len()];
+        accel.intersect_many(&mesh, &batch, &t_max, &mut got);
+        for (k, ((ray, t), g)) in rays.iter().zip(&got).enumerate() {
+            let own = accel.intersect(&mesh, ray, *t);
+            assert_eq!(bits(g), bits(&own), "{kind}: batch ray {k} {ray:?} t_max {t}: {g:?}, own query {own:?}");
         }
     }
 });

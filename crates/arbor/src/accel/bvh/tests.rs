@@ -345,11 +345,9 @@ fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() 
     }
 }
 
-#[test]
-fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
-    use super::wide::{intersect_with, Kernel};
-    let mesh = soup(5000, 29);
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+/// The node-test kernels this processor runs, scalar first.
+fn kernels() -> Vec<super::wide::Kernel> {
+    use super::wide::Kernel;
     let mut kernels = vec![Kernel::Scalar];
     if cfg!(target_arch = "x86_64") {
         kernels.push(Kernel::Sse);
@@ -357,6 +355,15 @@ fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
     if Kernel::detect() == Kernel::Avx2 {
         kernels.push(Kernel::Avx2);
     }
+    kernels
+}
+
+#[test]
+fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
+    use super::wide::{intersect_with, Kernel};
+    let mesh = soup(5000, 29);
+    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let kernels = kernels();
     for ray in rays(3000, 8) {
         let run = |k: Kernel| {
             let mut c = TraversalCounts::default();
@@ -373,18 +380,12 @@ fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
 
 #[test]
 fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind() {
-    use super::wide::{intersect_many_with, Kernel};
+    use super::wide::intersect_many_with;
     let mesh = soup(4000, 41);
     let opaque = Opaque(&mesh);
     let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
     let without = Bvh::build_sah(&opaque, &BvhParams::default());
-    let mut kernels = vec![Kernel::Scalar];
-    if cfg!(target_arch = "x86_64") {
-        kernels.push(Kernel::Sse);
-    }
-    if Kernel::detect() == Kernel::Avx2 {
-        kernels.push(Kernel::Avx2);
-    }
+    let kernels = kernels();
     // Random rays with rays that trivially miss mixed in (NaN origin, zero direction, t_max of zero,
     // negative or NaN), so that slots are refilled past them, and short t_max that end rays early.
     let mut batch: Vec<(Ray, f32)> = rays(1500, 3).into_iter().map(|r| (r, 30.0)).collect();

@@ -526,32 +526,24 @@ fn visit<L: Leaves, const K: u8, const MERGED: bool>(
     }
     let first = mask.trailing_zeros() as usize;
     let rest = mask & (mask - 1);
-    if MERGED && rest & rest.wrapping_sub(1) == 0 {
-        // One or two children, without a branch on which: continue with the nearer and push the other
-        // (with one child, `second` is `first` and the entry written is not kept).
-        let two = rest != 0;
-        let second = std::hint::select_unpredictable(two, rest.trailing_zeros() as usize, first);
-        let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
-        let r = Ref { child: node.child[push], count: node.count[push] };
-        stack[*sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
-        *sp += two as usize;
-        prefetch(nodes, leaves, r);
-        let cur = Ref { child: node.child[go], count: node.count[go] };
-        prefetch(nodes, leaves, cur);
-        return Some(cur);
-    }
-    if rest == 0 {
+    if !MERGED && rest == 0 {
         let cur = Ref { child: node.child[first], count: node.count[first] };
         prefetch(nodes, leaves, cur);
         return Some(cur);
     }
-    if rest & (rest - 1) == 0 {
-        // Two children, the common case: continue with the nearer, push the other.
-        let second = rest.trailing_zeros() as usize;
+    if rest & rest.wrapping_sub(1) == 0 {
+        // Two children, the common case: continue with the nearer, push the other. Merged, one child
+        // takes this path too, without a branch: `second` is `first` and the entry written is not kept.
+        let two = rest != 0;
+        let second = if MERGED {
+            std::hint::select_unpredictable(two, rest.trailing_zeros() as usize, first)
+        } else {
+            rest.trailing_zeros() as usize
+        };
         let (go, push) = if near[second] < near[first] { (second, first) } else { (first, second) };
         let r = Ref { child: node.child[push], count: node.count[push] };
         stack[*sp] = MaybeUninit::new(Entry { r, near: near[push], slack: slack[push] });
-        *sp += 1;
+        *sp += two as usize;
         prefetch(nodes, leaves, r);
         let cur = Ref { child: node.child[go], count: node.count[go] };
         prefetch(nodes, leaves, cur);
@@ -695,33 +687,34 @@ fn many<L: Leaves, const K: u8>(
     loop {
         a.step::<L, K>(nodes, leaves);
         b.step::<L, K>(nodes, leaves);
-        if a.done {
-            out[ia] = a.best.hit;
-            match next_ray(rays, t_max, out, &mut next) {
-                Some(i) => {
-                    ia = i;
-                    a.restart(root, &rays[i], t_max[i]);
-                }
-                None => {
-                    out[ib] = b.finish::<L, K>(nodes, leaves);
-                    return;
-                }
-            }
+        if a.done && !refill(&mut a, &mut ia, root, rays, t_max, out, &mut next) {
+            out[ib] = b.finish::<L, K>(nodes, leaves);
+            return;
         }
-        if b.done {
-            out[ib] = b.best.hit;
-            match next_ray(rays, t_max, out, &mut next) {
-                Some(i) => {
-                    ib = i;
-                    b.restart(root, &rays[i], t_max[i]);
-                }
-                None => {
-                    out[ia] = a.finish::<L, K>(nodes, leaves);
-                    return;
-                }
-            }
+        if b.done && !refill(&mut b, &mut ib, root, rays, t_max, out, &mut next) {
+            out[ia] = a.finish::<L, K>(nodes, leaves);
+            return;
         }
     }
+}
+
+/// Hands finished walk `w`'s hit to `out[*i]` and starts it on the batch's next ray (its index into
+/// `*i`); false when no ray is left.
+#[inline(always)]
+fn refill<'r>(
+    w: &mut Walk<'r>,
+    i: &mut usize,
+    root: Ref,
+    rays: &'r [Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+    next: &mut usize,
+) -> bool {
+    out[*i] = w.best.hit;
+    let Some(k) = next_ray(rays, t_max, out, next) else { return false };
+    *i = k;
+    w.restart(root, &rays[k], t_max[k]);
+    true
 }
 
 /// The index of the batch's next ray from `*next` on that needs a traversal; the rays skipped on the
