@@ -424,47 +424,82 @@ pub(in crate::accel::bvh) unsafe fn intersect_with<P: Primitives + ?Sized, const
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
+    // SAFETY: the caller vouches for the kernel.
+    unsafe { run_with(kernel, wide, indices, prims, Closest::<COUNT> { ray, t_max, counts }) }
+}
+
+/// A traversal of the tree, compiled once per kernel and kind of leaf by [`run_with`]: the three queries
+/// share that dispatch.
+trait Traversal {
+    type Out;
+    /// The answer when the tree is empty.
+    fn empty(self) -> Self::Out;
+    /// The traversal from `root`.
+    fn run<L: Leaves, const K: u8>(self, nodes: &[Node8], leaves: &L, root: Ref) -> Self::Out;
+}
+
+/// Runs `t` with `kernel`'s node test over `wide`'s kind of leaf.
+///
+/// # Safety
+/// The processor must support `kernel` (AVX2 for [`Kernel::Avx2`]).
+#[inline]
+unsafe fn run_with<P: Primitives + ?Sized, T: Traversal>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    t: T,
+) -> T::Out {
     match kernel {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller vouches for AVX2.
-        Kernel::Avx2 => unsafe { intersect_avx2::<P, COUNT>(wide, indices, prims, ray, t_max, counts) },
-        Kernel::Sse if cfg!(target_arch = "x86_64") => {
-            intersect_kernel::<P, COUNT, SSE>(wide, indices, prims, ray, t_max, counts)
-        }
-        _ => intersect_kernel::<P, COUNT, SCALAR>(wide, indices, prims, ray, t_max, counts),
+        Kernel::Avx2 => unsafe { run_avx2(wide, indices, prims, t) },
+        Kernel::Sse if cfg!(target_arch = "x86_64") => run_kernel::<P, T, SSE>(wide, indices, prims, t),
+        _ => run_kernel::<P, T, SCALAR>(wide, indices, prims, t),
     }
 }
 
-/// The whole query compiled for AVX2, so that the node test inlines.
+/// The whole traversal compiled for AVX2, so that the node test inlines.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn intersect_avx2<P: Primitives + ?Sized, const COUNT: bool>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    ray: &Ray,
-    t_max: f32,
-    counts: &mut TraversalCounts,
-) -> Option<Hit> {
-    intersect_kernel::<P, COUNT, AVX2>(wide, indices, prims, ray, t_max, counts)
+unsafe fn run_avx2<P: Primitives + ?Sized, T: Traversal>(wide: &Wide, indices: &[u32], prims: &P, t: T) -> T::Out {
+    run_kernel::<P, T, AVX2>(wide, indices, prims, t)
 }
 
 #[inline(always)]
-fn intersect_kernel<P: Primitives + ?Sized, const COUNT: bool, const K: u8>(
+fn run_kernel<P: Primitives + ?Sized, T: Traversal, const K: u8>(
     wide: &Wide,
     indices: &[u32],
     prims: &P,
-    ray: &Ray,
-    t_max: f32,
-    counts: &mut TraversalCounts,
-) -> Option<Hit> {
-    let root = wide.root?;
-    if trivially_misses(ray, t_max) {
-        return None;
-    }
+    t: T,
+) -> T::Out {
+    let Some(root) = wide.root else { return t.empty() };
     match &wide.blocks {
-        Some(blocks) => query::<_, COUNT, K>(&wide.nodes, &MeshLeaves { blocks }, root, ray, t_max, counts),
-        None => query::<_, COUNT, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, ray, t_max, counts),
+        Some(blocks) => t.run::<_, K>(&wide.nodes, &MeshLeaves { blocks }, root),
+        None => t.run::<_, K>(&wide.nodes, &PrimLeaves { indices, prims }, root),
+    }
+}
+
+/// The closest-hit query of one ray.
+struct Closest<'a, const COUNT: bool> {
+    ray: &'a Ray,
+    t_max: f32,
+    counts: &'a mut TraversalCounts,
+}
+
+impl<const COUNT: bool> Traversal for Closest<'_, COUNT> {
+    type Out = Option<Hit>;
+
+    fn empty(self) -> Option<Hit> {
+        None
+    }
+
+    #[inline(always)]
+    fn run<L: Leaves, const K: u8>(self, nodes: &[Node8], leaves: &L, root: Ref) -> Option<Hit> {
+        if trivially_misses(self.ray, self.t_max) {
+            return None;
+        }
+        query::<L, COUNT, K>(nodes, leaves, root, self.ray, self.t_max, self.counts)
     }
 }
 
@@ -622,44 +657,27 @@ pub(in crate::accel::bvh) unsafe fn intersect_many_with<P: Primitives + ?Sized>(
     out: &mut [Option<Hit>],
 ) {
     assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and hits differ in length");
-    match kernel {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller vouches for AVX2.
-        Kernel::Avx2 => unsafe { many_avx2(wide, indices, prims, rays, t_max, out) },
-        Kernel::Sse if cfg!(target_arch = "x86_64") => many_kernel::<P, SSE>(wide, indices, prims, rays, t_max, out),
-        _ => many_kernel::<P, SCALAR>(wide, indices, prims, rays, t_max, out),
+    // SAFETY: the caller vouches for the kernel.
+    unsafe { run_with(kernel, wide, indices, prims, Batch { rays, t_max, out }) }
+}
+
+/// The closest-hit queries of a batch.
+struct Batch<'a> {
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    out: &'a mut [Option<Hit>],
+}
+
+impl Traversal for Batch<'_> {
+    type Out = ();
+
+    fn empty(self) {
+        self.out.fill(None);
     }
-}
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn many_avx2<P: Primitives + ?Sized>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    rays: &[Ray],
-    t_max: &[f32],
-    out: &mut [Option<Hit>],
-) {
-    many_kernel::<P, AVX2>(wide, indices, prims, rays, t_max, out)
-}
-
-#[inline(always)]
-fn many_kernel<P: Primitives + ?Sized, const K: u8>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    rays: &[Ray],
-    t_max: &[f32],
-    out: &mut [Option<Hit>],
-) {
-    let Some(root) = wide.root else {
-        out.fill(None);
-        return;
-    };
-    match &wide.blocks {
-        Some(blocks) => many::<_, K>(&wide.nodes, &MeshLeaves { blocks }, root, rays, t_max, out),
-        None => many::<_, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, rays, t_max, out),
+    #[inline(always)]
+    fn run<L: Leaves, const K: u8>(self, nodes: &[Node8], leaves: &L, root: Ref) {
+        many::<L, K>(nodes, leaves, root, self.rays, self.t_max, self.out)
     }
 }
 
@@ -810,42 +828,26 @@ pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
     ray: &Ray,
     t_max: f32,
 ) -> bool {
-    match Kernel::detect() {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: `detect` found AVX2.
-        Kernel::Avx2 => unsafe { occluded_avx2(wide, indices, prims, ray, t_max) },
-        Kernel::Sse if cfg!(target_arch = "x86_64") => occluded_kernel::<P, SSE>(wide, indices, prims, ray, t_max),
-        _ => occluded_kernel::<P, SCALAR>(wide, indices, prims, ray, t_max),
-    }
+    // SAFETY: `detect` gives a kernel this processor runs.
+    unsafe { run_with(Kernel::detect(), wide, indices, prims, AnyHit { ray, t_max }) }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2<P: Primitives + ?Sized>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    ray: &Ray,
+/// The any-hit query of one ray.
+struct AnyHit<'a> {
+    ray: &'a Ray,
     t_max: f32,
-) -> bool {
-    occluded_kernel::<P, AVX2>(wide, indices, prims, ray, t_max)
 }
 
-#[inline(always)]
-fn occluded_kernel<P: Primitives + ?Sized, const K: u8>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    ray: &Ray,
-    t_max: f32,
-) -> bool {
-    let Some(root) = wide.root else { return false };
-    if trivially_misses(ray, t_max) {
-        return false;
+impl Traversal for AnyHit<'_> {
+    type Out = bool;
+
+    fn empty(self) -> bool {
+        false
     }
-    match &wide.blocks {
-        Some(blocks) => any_hit::<_, K>(&wide.nodes, &MeshLeaves { blocks }, root, ray, t_max),
-        None => any_hit::<_, K>(&wide.nodes, &PrimLeaves { indices, prims }, root, ray, t_max),
+
+    #[inline(always)]
+    fn run<L: Leaves, const K: u8>(self, nodes: &[Node8], leaves: &L, root: Ref) -> bool {
+        !trivially_misses(self.ray, self.t_max) && any_hit::<L, K>(nodes, leaves, root, self.ray, self.t_max)
     }
 }
 
