@@ -198,7 +198,8 @@ fn trace(
             let mut count = 0u64;
             let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
-            let per_batch = (BATCH / (k1 - k0) as usize).max(1);
+            let samples = (k1 - k0) as usize;
+            let per_batch = (BATCH / samples).max(1);
             let (mut batch, mut rngs, mut hits) = (Vec::new(), Vec::new(), Vec::new());
             for group in tile.chunks(per_batch) {
                 batch.clear();
@@ -219,7 +220,6 @@ fn trace(
                     hits.resize(batch.len(), None);
                     scene.geometry.intersect_many(&batch, f32::INFINITY, &mut hits);
                 }
-                let samples = (k1 - k0) as usize;
                 for p in 0..group.len() {
                     let mut sum = SampleSum::default();
                     for s in p * samples..(p + 1) * samples {

@@ -29,10 +29,7 @@ impl<'a> Whitted<'a> {
 
     /// Radiance (in the scene's units) along a camera ray.
     pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, count: &mut u64) -> Color {
-        let ray = self.camera_ray(ray);
-        *count += 1;
-        let hit = self.scene.geometry.intersect(&ray, f32::INFINITY);
-        self.shade(&ray, hit, 0, None, rng, count)
+        self.li(&self.camera_ray(ray), 0, None, rng, count)
     }
 
     /// The camera ray as it is traced: culling back faces if the render asks for it.

@@ -201,11 +201,11 @@ impl SceneGeometry {
                         }
                     }
                 }
-                Shape::Sphere(s) => {
+                Shape::Sphere(_) => {
                     for ((o, l), r) in out.iter_mut().zip(&mut limit).zip(rays) {
-                        if let Some(t) = s.intersect(r, *l) {
-                            *o = Some(Hit::new(i as u32, PrimHit::new(t, 0.0, 0.0)));
-                            *l = t;
+                        if let Some(h) = self.objects.intersect(i, r, *l) {
+                            *o = Some(Hit::new(i as u32, h));
+                            *l = h.t;
                         }
                     }
                 }
