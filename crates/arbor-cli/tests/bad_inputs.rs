@@ -98,8 +98,12 @@ fn catalogue() -> Vec<Row> {
     // name itself or another instance (bases must be <Mesh> ids, so no cycle can be written).
     render("ply_is_the_scene.xml", 3, "error: ply_is_the_scene.xml:29:9: Mesh 1: mesh file 'ply_is_the_scene.xml': unknown mesh file extension `.xml` (supported: .ply, .obj, .off)\n"),
     render("ply_is_xml.xml", 3, "error: scene_as.ply:1: not a PLY file (the first line must be `ply`)\n"),
-    render("instance_of_itself.xml", 3, "error: instance_of_itself.xml:29:30: MeshInstance 1: unknown base mesh id '1'\n"),
-    render("instance_loop.xml", 3, "error: instance_loop.xml:29:30: MeshInstance 1: unknown base mesh id '2'\n"),
+    render("instance_of_itself.xml", 3, "error: instance_of_itself.xml:29:30: MeshInstance 1: base mesh id '1' leads back to this instance\n"),
+    render(
+        "instance_loop.xml",
+        3,
+        "error: instance_loop.xml:30:30: MeshInstance 2: base mesh id '1' leads back to this instance\n",
+    ),
     render("instance_of_sphere.xml", 3, "error: instance_of_sphere.xml:30:30: MeshInstance 2: unknown base mesh id '1'\n"),
     // Unknown elements and unused properties: warnings, and the render succeeds.
     render("unknown_element.xml", 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),

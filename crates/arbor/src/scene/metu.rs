@@ -49,6 +49,7 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
         vertices: Vec::new(),
         transforms: HashMap::new(),
         materials: HashMap::new(),
+        images: image_table(root),
     };
     r.globals(root)?;
     if let Some(v) = r.one(root, "VertexData") {
@@ -126,6 +127,8 @@ struct Reader<'a> {
     vertices: Vec<Vec3>,
     transforms: HashMap<String, Transform>,
     materials: HashMap<String, usize>,
+    /// `Textures/Images/Image` by id: the file name as written, for lights that name an image.
+    images: HashMap<String, String>,
     /// A pre-2020 file: untyped materials take their kind from the elements present.
     legacy: bool,
 }
@@ -138,6 +141,19 @@ fn typed_materials(root: &Node) -> bool {
         .filter(|c| c.name == "Materials")
         .flat_map(|m| m.children.iter().filter(|c| c.name == "Material"))
         .any(|m| m.attrs.iter().any(|a| a.name == "type"))
+}
+
+/// The `Image` elements of `Textures/Images` by id (the last one of an id wins), looked up without
+/// marking anything as read: textures report themselves.
+fn image_table(root: &Node) -> HashMap<String, String> {
+    let images = root.children.iter().filter(|c| c.name == "Textures").flat_map(|t| &t.children);
+    images
+        .filter(|c| c.name == "Images")
+        .flat_map(|i| i.children.iter().filter(|c| c.name == "Image"))
+        .filter_map(|img| {
+            Some((img.attrs.iter().find(|a| a.name == "id")?.trimmed().to_string(), img.trimmed().to_string()))
+        })
+        .collect()
 }
 
 fn vertex_data(v: &Node, path: &Path) -> Result<Vec<Vec3>> {
@@ -288,8 +304,22 @@ impl Reader<'_> {
                     radiance: self.req(n, "Radiance")?.vec3(p)?,
                 },
                 "SphericalDirectionalLight" => {
-                    let name_node = self.req(n, "EnvMapName")?;
-                    let name = name_node.trimmed();
+                    // Before 2022 the light names its file (`EnvMapName`); from 2022 on an image
+                    // of `Textures/Images` (`ImageId`).
+                    let (name_node, name) = match (self.one(n, "EnvMapName"), self.one(n, "ImageId")) {
+                        (Some(e), _) => (e, e.trimmed().to_string()),
+                        (None, Some(i)) => {
+                            let id = i.trimmed();
+                            let file = self.images.get(id).ok_or_else(|| {
+                                self.err(i, format!("<ImageId>: no <Image id=\"{id}\"> in <Textures><Images>"))
+                            })?;
+                            (i, file.clone())
+                        }
+                        (None, None) => {
+                            let msg = "<SphericalDirectionalLight>: missing <EnvMapName> or <ImageId>";
+                            return Err(self.err(n, msg));
+                        }
+                    };
                     self.desc.environment_loc = Some(name_node.loc(p));
                     if self.desc.environment.is_some() {
                         let msg = "duplicate environment light; the last one wins".to_string();
@@ -354,6 +384,65 @@ mod tests {
         assert_eq!(d.objects[0].transform.point(o), Vec3::splat(3.0));
         // Without reset: the base's translation first, then the instance's scale.
         assert_eq!(d.objects[1].transform.point(o), Vec3::new(3.0, 3.0, 18.0));
+    }
+
+    #[test]
+    fn metu_instance_of_instance_composes_transforms_down_the_chain() {
+        // 4 -> 3 -> 2 (mesh); 5 resets on top of 4; 3 has its own material, which 4 inherits.
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0 1 0 0 0 1 0</VertexData>\
+             <Transformations><Translation id=\"1\">0 0 5</Translation>\
+             <Scaling id=\"1\">3 3 3</Scaling></Transformations><Objects>\
+             <MeshInstance id=\"4\" baseMeshId=\"3\"><Transformations>t1</Transformations></MeshInstance>\
+             <MeshInstance id=\"5\" baseMeshId=\"4\" resetTransform=\"true\">\
+             <Transformations>s1</Transformations></MeshInstance>\
+             <Mesh id=\"2\"><Material>1</Material><Transformations>t1</Transformations>\
+             <Faces>1 2 3</Faces></Mesh>\
+             <MeshInstance id=\"3\" baseMeshId=\"2\"><Material>1</Material>\
+             <Transformations>s1</Transformations></MeshInstance></Objects>"
+        );
+        let d = read_xml(&body).unwrap();
+        for i in [0, 1, 3] {
+            assert_eq!(d.objects[i].shape, ShapeDesc::Instance { base: 2 }, "object {i}");
+        }
+        let o = Vec3::ONE;
+        // 3: t1 then s1; 4: that, then t1 again; 5: s1 only.
+        assert_eq!(d.objects[3].transform.point(o), Vec3::new(3.0, 3.0, 18.0));
+        assert_eq!(d.objects[0].transform.point(o), Vec3::new(3.0, 3.0, 23.0));
+        assert_eq!(d.objects[1].transform.point(o), Vec3::splat(3.0));
+    }
+
+    #[test]
+    fn metu_instance_cycles_and_unknown_bases_are_errors() {
+        let cycle = format!(
+            "{MATERIAL}<Objects><MeshInstance id=\"7\" baseMeshId=\"8\"/>\
+             <MeshInstance id=\"8\" baseMeshId=\"7\"/></Objects>"
+        );
+        let e = read_xml(&cycle).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:218: MeshInstance 8: base mesh id '7' leads back to this instance");
+        let unknown = format!("{MATERIAL}<Objects><MeshInstance id=\"7\" baseMeshId=\"9\"/></Objects>");
+        let e = read_xml(&unknown).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:181: MeshInstance 7: unknown base mesh id '9'");
+    }
+
+    #[test]
+    fn metu_spherical_light_names_a_file_or_an_image_id() {
+        let images = "<Textures><Images><Image id=\"1\">a.png</Image><Image id=\"2\">sky.exr</Image></Images>\
+                      </Textures>";
+        let by_id = format!(
+            "{images}<Lights><SphericalDirectionalLight id=\"1\"><ImageId>2</ImageId>\
+                             </SphericalDirectionalLight></Lights>"
+        );
+        assert_eq!(read_xml(&by_id).unwrap().environment, Some(PathBuf::from("sky.exr")));
+        let by_name = "<Lights><SphericalDirectionalLight id=\"1\"><EnvMapName>env.hdr</EnvMapName>\
+                       </SphericalDirectionalLight></Lights>";
+        assert_eq!(read_xml(by_name).unwrap().environment, Some(PathBuf::from("env.hdr")));
+        let missing = by_id.replace(">2<", ">3<");
+        let e = read_xml(&missing).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:144: <ImageId>: no <Image id=\"3\"> in <Textures><Images>");
+        let neither = "<Lights><SphericalDirectionalLight id=\"1\"/></Lights>";
+        let e = read_xml(neither).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:16: <SphericalDirectionalLight>: missing <EnvMapName> or <ImageId>");
     }
 
     #[test]

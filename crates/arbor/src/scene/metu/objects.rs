@@ -3,8 +3,9 @@
 //!
 //! Inline faces are 1-based `VertexData` ids (plus `vertexOffset`); each mesh is compacted to the
 //! vertices it uses, renumbered from 0 in order of first use, so that a scene whose meshes share one
-//! big vertex list does not copy that list into every mesh. Instances name their base mesh by id and
-//! may come before it, so they are resolved after all objects are read.
+//! big vertex list does not copy that list into every mesh. Instances name their base by id: a mesh or
+//! another instance, which may come later in the file, so they are resolved after all objects are read,
+//! each base before the instances built on it.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -16,7 +17,7 @@ use crate::scene::tree::{Attr, Node};
 use crate::scene::{MeshSource, ObjectDesc, ShapeDesc};
 use crate::{Error, Result};
 
-/// A `MeshInstance` waiting for its base mesh; its own transform is already in its object.
+/// A `MeshInstance` waiting for its base; its own transform is already in its object.
 struct Pending<'n> {
     object: usize,
     base_id: &'n Attr,
@@ -24,10 +25,20 @@ struct Pending<'n> {
     has_material: bool,
 }
 
+/// What a `MeshInstance` id names while instances are resolved.
+#[derive(Clone, Copy)]
+enum Base {
+    /// A mesh: the object index.
+    Mesh(usize),
+    /// An instance: its index in the pending list.
+    Instance(usize),
+}
+
 impl Reader<'_> {
     /// Every object of `Objects`, in file order, then the instances' bases.
     pub(super) fn objects(&mut self, objects: &Node) -> Result<()> {
-        let mut mesh_ids: HashMap<String, usize> = HashMap::new();
+        let mut mesh_ids: HashMap<String, Base> = HashMap::new();
+        let mut instance_ids: HashMap<String, Base> = HashMap::new();
         let mut pending = Vec::new();
         for o in &objects.children {
             let kind = o.name.as_str();
@@ -61,31 +72,84 @@ impl Reader<'_> {
                 (material, self.shape(o, &name)?)
             };
             let transform = self.transform_of(o)?;
-            if kind == "Mesh" {
-                if let Some(id) = &id {
-                    mesh_ids.insert(id.clone(), self.desc.objects.len());
+            let base = match kind {
+                "Mesh" => Some(Base::Mesh(self.desc.objects.len())),
+                "MeshInstance" => Some(Base::Instance(pending.len() - 1)),
+                _ => None,
+            };
+            match (&id, base) {
+                (Some(id), Some(base @ Base::Mesh(_))) => {
+                    mesh_ids.insert(id.clone(), base);
                 }
+                (Some(id), Some(base)) => {
+                    instance_ids.insert(id.clone(), base);
+                }
+                _ => {}
             }
             self.desc.objects.push(ObjectDesc { name, material, shape, transform, loc: o.loc(self.path) });
         }
-        for p in pending {
-            let id = p.base_id.trimmed();
-            let base = *mesh_ids.get(id).ok_or_else(|| {
-                let name = &self.desc.objects[p.object].name;
-                Error::input(p.base_id.loc(self.path), format!("{name}: unknown base mesh id '{id}'"))
-            })?;
-            let (base_transform, base_material) = {
-                let b = &self.desc.objects[base];
-                (b.transform, b.material)
-            };
-            let inst = &mut self.desc.objects[p.object];
-            inst.shape = ShapeDesc::Instance { base };
-            // Without resetTransform the instance moves the base mesh from where the base put it.
-            if !p.reset {
-                inst.transform = base_transform.then(&inst.transform);
+        // Before 2022 meshes and instances were numbered apart ("MeshInstance 1" of "Mesh 1"); since,
+        // one id space holds both. A mesh of the id is the base when there is one.
+        for (id, base) in instance_ids {
+            mesh_ids.entry(id).or_insert(base);
+        }
+        self.resolve_instances(&pending, &mesh_ids)
+    }
+
+    /// Gives every pending instance its mesh, and its base's transform and material where it asks for
+    /// them, resolving each base instance first; a chain that comes back to itself is an error.
+    fn resolve_instances(&mut self, pending: &[Pending], ids: &HashMap<String, Base>) -> Result<()> {
+        // The mesh each resolved instance shows.
+        let mut mesh_of: Vec<Option<usize>> = vec![None; pending.len()];
+        let mut on_chain = vec![false; pending.len()];
+        for start in 0..pending.len() {
+            // Walk down to the first base that is resolved (or a mesh), then resolve back up.
+            let mut chain = vec![start];
+            on_chain[start] = true;
+            loop {
+                let p = &pending[chain[chain.len() - 1]];
+                let id = p.base_id.trimmed();
+                let base = *ids.get(id).ok_or_else(|| {
+                    let name = &self.desc.objects[p.object].name;
+                    Error::input(p.base_id.loc(self.path), format!("{name}: unknown base mesh id '{id}'"))
+                })?;
+                match base {
+                    Base::Instance(b) if mesh_of[b].is_none() => {
+                        if on_chain[b] {
+                            let name = &self.desc.objects[p.object].name;
+                            let msg = format!("{name}: base mesh id '{id}' leads back to this instance");
+                            return Err(Error::input(p.base_id.loc(self.path), msg));
+                        }
+                        chain.push(b);
+                        on_chain[b] = true;
+                    }
+                    _ => break,
+                }
             }
-            if !p.has_material {
-                inst.material = base_material;
+            for &i in chain.iter().rev() {
+                on_chain[i] = false;
+                if mesh_of[i].is_some() {
+                    continue;
+                }
+                let p = &pending[i];
+                let (base_object, mesh) = match ids[p.base_id.trimmed()] {
+                    Base::Mesh(m) => (m, m),
+                    Base::Instance(b) => (pending[b].object, mesh_of[b].unwrap_or_default()),
+                };
+                let (base_transform, base_material) = {
+                    let b = &self.desc.objects[base_object];
+                    (b.transform, b.material)
+                };
+                let inst = &mut self.desc.objects[p.object];
+                inst.shape = ShapeDesc::Instance { base: mesh };
+                // Without resetTransform the instance moves its base from where the base put it.
+                if !p.reset {
+                    inst.transform = base_transform.then(&inst.transform);
+                }
+                if !p.has_material {
+                    inst.material = base_material;
+                }
+                mesh_of[i] = Some(mesh);
             }
         }
         Ok(())
