@@ -8,14 +8,12 @@
 //! back into the same bits.
 #![warn(missing_docs)]
 
-pub mod accel;
 pub mod accum;
 pub mod bench;
 pub mod camera;
 pub mod error;
 pub mod farm;
 pub mod film;
-pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
@@ -25,7 +23,6 @@ pub mod mesh_io;
 pub mod render;
 pub mod sampler;
 pub mod scene;
-#[cfg(test)]
-mod test_rng;
 
+pub use arbor_accel::{accel, geometry};
 pub use error::{Error, Location, Result};

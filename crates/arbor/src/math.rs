@@ -1,13 +1,7 @@
-//! Vector types (glam, single precision), rays, boxes and affine transforms.
+//! The renderer's vector vocabulary: the geometry types of [`arbor_accel::math`] (vectors, rays, boxes,
+//! transforms), plus what only shading needs (colours, reflection, tangent frames).
 
-mod aabb;
-mod ray;
-mod transform;
-
-pub use aabb::Aabb;
-pub use glam::{Mat3, Mat4, Vec2, Vec3};
-pub use ray::Ray;
-pub use transform::Transform;
+pub use arbor_accel::math::*;
 
 /// Linear RGB radiance. Scene files use their own scale; see [`crate::scene::SceneDesc::radiance_scale`].
 pub type Color = Vec3;

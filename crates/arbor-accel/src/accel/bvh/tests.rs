@@ -234,18 +234,6 @@ pub(super) fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) 
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
 }
 
-/// The shared Stanford bunny (`../shared/meshes` beside the checkout), or `None` after saying why; under
-/// CI (`CI=true`) an absent mesh is a failure.
-pub(super) fn bunny() -> Option<TriangleMesh> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/stanford-bunny.obj");
-    if !path.is_file() {
-        assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "{} is required under CI", path.display());
-        eprintln!("SKIPPED: {} not found", path.display());
-        return None;
-    }
-    Some(crate::mesh_io::load_mesh(&path).unwrap())
-}
-
 /// SAH cost of `bvh` (stats' convention: traversal and intersection cost 1).
 pub(super) fn sah(bvh: &Bvh) -> f64 {
     Accel::<TriangleMesh>::stats(bvh).sah_cost
