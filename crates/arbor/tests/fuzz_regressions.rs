@@ -145,7 +145,7 @@ fn fuzz_accel_huge_direction_tiny_t() {
         [-29.5, -30.0, -13.75],
     ];
     let tris = [[2, 1, 0], [0, 2, 0], [5, 2, 4], [0, 0, 0]];
-    let rays = [([-2.0389849502874925e-34, -26.25, -4.5], [1.6938020184141926e+23, 2.032059015034331e+34, -0.25], 1.0)];
+    let rays = [([-2.038_985e-34, -26.25, -4.5], [1.693_802e23, 2.032_059e34, -0.25], 1.0)];
     let failures = differential(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -159,7 +159,7 @@ fn fuzz_accel_huge_direction_tiny_t() {
 #[test]
 fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
     let verts = [
-        [-30.0, -30.0, 5.1605320697943087e+36],
+        [-30.0, -30.0, 5.160_532e36],
         [0.0, 0.0, 1.0],
         [-30.0, 1.0, -30.0],
         [-30.0, -29.75, -29.25],
@@ -167,7 +167,7 @@ fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
         [0.0, 0.0, 1.0],
     ];
     let tris = [[0, 3, 0], [0, 4, 4], [0, 0, 2], [0, 0, 0], [0, 0, 2], [3, 5, 2], [0, 3, 5]];
-    let rays = [([-30.0, 8.25, 1.6535321879032841e-43], [30.0, -8.25, 1.0], f32::INFINITY)];
+    let rays = [([-30.0, 8.25, 1.65e-43], [30.0, -8.25, 1.0], f32::INFINITY)];
     let failures = differential(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -183,7 +183,7 @@ fn fuzz_accel_closest_hit_at_shared_vertex_with_huge_corner() {
 fn fuzz_accel_subnormal_direction() {
     let verts = [[-16.5, -30.0, -30.0], [-29.75, 1.5, -30.0], [-30.0, -30.0, -30.0], [0.0, 0.0, 1.0]];
     let tris = [[0, 1, 2], [2, 1, 3]];
-    let rays = [([6.887942471542206e-41, -30.0, -30.0], [-6.887942471542206e-41, 30.0, 31.0], f32::INFINITY)];
+    let rays = [([6.888e-41, -30.0, -30.0], [-6.888e-41, 30.0, 31.0], f32::INFINITY)];
     let failures = differential(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -206,9 +206,9 @@ fn fuzz_accel_direction_component_negligible_against_the_major_one() {
     let verts = [
         [-8.75, -24.75, -29.5],
         [0.0, 0.0, 0.0],
-        [0.0, 0.0, 1.2280755823866435e+30],
+        [0.0, 0.0, 1.228_075_6e30],
         [0.0, 0.0, 0.0],
-        [4.174460002524154e-15, 1.5, 1.25],
+        [4.174_46e-15, 1.5, 1.25],
         [-0.25, -28.75, -29.5],
     ];
     let tris = [
@@ -237,30 +237,20 @@ fn fuzz_accel_direction_component_negligible_against_the_major_one() {
         [0, 5, 0],
         [0, 0, 0],
     ];
-    let rays = [(
-        [0.0, 1.616255289003517e+32, -30.0],
-        [4.174460002524154e-15, -1.616255289003517e+32, 31.25],
-        f32::INFINITY,
-        true,
-    )];
+    let rays = [([0.0, 1.616_255_3e32, -30.0], [4.174_46e-15, -1.616_255_3e32, 31.25], f32::INFINITY, true)];
     let failures = differential_culled(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 
     let verts = [
         [0.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0842021724855044e-19],
+        [0.0, 0.0, 1.084_202_2e-19],
         [1.25, 0.0, 0.0],
         [1.0, 0.0, -30.0],
         [-29.75, 1.0, -30.0],
         [-29.75, -29.5, -30.0],
     ];
     let tris = [[1, 2, 2], [1, 0, 0], [0, 1, 0], [4, 5, 1], [3, 4, 0], [3, 3, 3]];
-    let rays = [(
-        [4.1198301172484685e+31, 0.0, 0.0],
-        [-4.1198301172484685e+31, 0.0, 1.0842021724855044e-19],
-        f32::INFINITY,
-        true,
-    )];
+    let rays = [([4.119_83e31, 0.0, 0.0], [-4.119_83e31, 0.0, 1.084_202_2e-19], f32::INFINITY, true)];
     let failures = differential_culled(&verts, &tris, &rays);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

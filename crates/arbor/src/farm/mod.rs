@@ -21,7 +21,7 @@ pub use partial::{read_partial, write_partial, Partial};
 /// or `n == 0`.
 pub fn tile_grid(n: u32, w: u32, h: u32) -> Option<(u32, u32)> {
     let mut best: Option<((u32, u32), f64)> = None;
-    for cols in (1..=n).filter(|c| n % c == 0) {
+    for cols in (1..=n).filter(|c| n.is_multiple_of(*c)) {
         let rows = n / cols;
         if cols > w || rows > h {
             continue;
