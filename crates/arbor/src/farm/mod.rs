@@ -6,7 +6,7 @@
 //!   maps straight to a tile.
 //! - [`partial`]: a slice's result as an OpenEXR file: the frame (display window), the slice's window
 //!   (data window), the exact per-pixel sample sums and weights, and the render's identity.
-//! - [`merge`]: checks that partials fit together (same render, no overlap, no gap in pixels or samples)
+//! - [`merge()`]: checks that partials fit together (same render, no overlap, no gap in pixels or samples)
 //!   and adds their sums; sums are exact integers ([`crate::accum`]), so grouping does not matter.
 
 pub mod merge;
