@@ -48,7 +48,7 @@ const LEAF: u32 = 3;
 
 /// One node of the flat array: pbrt's `KdAccelNode`, 8 bytes.
 ///
-/// `flags`' low two bits are the split axis (0, 1, 2) or [`LEAF`]; the upper 30 bits are the above
+/// `flags`' low two bits are the split axis (0, 1, 2) or `LEAF` (3); the upper 30 bits are the above
 /// child's index (inner node) or the primitive count (leaf). `data` is the split position's bits (inner
 /// node), the primitive itself (leaf of one) or the offset of the first reference (larger leaf).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
