@@ -32,6 +32,7 @@ use super::{Octree, OctreeParams, Primitives};
 /// # Ok::<(), arbor_accel::accel::ConfigError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum AccelConfig {
     /// Brute force: no structure, no parameters.
     Brute,

@@ -112,6 +112,39 @@ impl Hit {
 }
 
 /// What a structure indexes: a set of bounded primitives addressed by index `0..len()`.
+///
+/// [`crate::geometry::TriangleMesh`] implements it; so can any other shape. Spheres, for example:
+///
+/// ```
+/// use arbor_accel::accel::{AccelConfig, PrimHit, Primitives, Structure};
+/// use arbor_accel::geometry::Sphere;
+/// use arbor_accel::math::{Aabb, Ray, Transform, Vec3};
+///
+/// struct Balls(Vec<Sphere>);
+///
+/// impl Primitives for Balls {
+///     fn len(&self) -> usize {
+///         self.0.len()
+///     }
+///     fn bounds(&self, i: usize) -> Aabb {
+///         self.0[i].bounds()
+///     }
+///     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
+///         self.0[i].intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
+///     }
+/// }
+///
+/// let ball = |x: f32| Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 0.5, transform: Transform::IDENTITY };
+/// let balls = Balls((0..100).map(|i| ball(i as f32)).collect());
+/// let structure = Structure::build(&"kdtree".parse()?, balls)?;
+/// let along_x = Ray::new(Vec3::new(-10.0, 0.0, 0.0), Vec3::X);
+/// let hit = structure.intersect(&along_x, f32::INFINITY).unwrap();
+/// assert_eq!(hit.prim, 0);
+/// assert!((hit.t - 9.5).abs() < 1e-5);
+/// let from_above = Ray::new(Vec3::new(42.0, 5.0, 0.0), -Vec3::Y);
+/// assert_eq!(structure.intersect(&from_above, f32::INFINITY).unwrap().prim, 42);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub trait Primitives: Sync {
     /// Number of primitives.
     fn len(&self) -> usize;
@@ -233,6 +266,7 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
 
 /// The structures Arbor can build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum AccelKind {
     /// Tests every primitive: the reference.
     Brute,
