@@ -407,6 +407,14 @@ mod tests {
         assert!(c.build_accel(&mesh).is_err(), "building checks the parameters first");
         let c = AccelConfig::KdTree(KdTreeParams { empty_bonus: f32::NAN, ..KdTreeParams::default() });
         assert!(c.check().is_err());
+        let c = AccelConfig::Octree(OctreeParams { max_leaf_prims: 0, ..OctreeParams::default() });
+        assert_eq!(c.check().unwrap_err().to_string(), "parameter 'leaf': 0 is outside its range >= 1");
+        let c = AccelConfig::BvhMedian(MedianParams { max_leaf_prims: usize::MAX });
+        assert_eq!(
+            c.check().unwrap_err().to_string(),
+            format!("parameter 'leaf': {} is outside its range 1..=64", i64::MAX),
+            "a huge count is reported as huge, not wrapped"
+        );
     }
 
     #[test]

@@ -93,6 +93,11 @@ pub enum ParamValue {
 }
 
 impl ParamValue {
+    /// A count or depth as a value (saturating: a field set directly past `i64::MAX` still reads as
+    /// out of range, with its size).
+    pub(crate) fn count(n: usize) -> ParamValue {
+        ParamValue::Int(i64::try_from(n).unwrap_or(i64::MAX))
+    }
     /// The value as an index or count (0 for anything else: only called where the range is integral).
     pub(crate) fn as_usize(&self) -> usize {
         match *self {

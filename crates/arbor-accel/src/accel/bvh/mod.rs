@@ -188,11 +188,11 @@ impl ParamSet for BvhParams {
     }
     fn get(&self, key: &str) -> Option<ParamValue> {
         Some(match key {
-            "leaf" => ParamValue::Int(self.max_leaf_prims as i64),
-            "bins" => ParamValue::Int(self.bins as i64),
+            "leaf" => ParamValue::count(self.max_leaf_prims),
+            "bins" => ParamValue::count(self.bins),
             "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
             "intersection-cost" => ParamValue::Float(self.intersection_cost.into()),
-            "leaf-block" => ParamValue::Int(self.leaf_block as i64),
+            "leaf-block" => ParamValue::count(self.leaf_block),
             _ => return None,
         })
     }
@@ -233,7 +233,7 @@ impl ParamSet for MedianParams {
         Self::PARAMS
     }
     fn get(&self, key: &str) -> Option<ParamValue> {
-        (key == "leaf").then_some(ParamValue::Int(self.max_leaf_prims as i64))
+        (key == "leaf").then_some(ParamValue::count(self.max_leaf_prims))
     }
     fn put(&mut self, key: &str, v: ParamValue) {
         if key == "leaf" {

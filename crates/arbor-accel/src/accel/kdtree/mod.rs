@@ -212,7 +212,7 @@ impl ParamSet for KdTreeParams {
             "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
             "intersection-cost" => ParamValue::Float(self.intersection_cost.into()),
             "empty-bonus" => ParamValue::Float(self.empty_bonus.into()),
-            "depth" => self.max_depth.map_or(ParamValue::Auto, |d| ParamValue::Int(d as i64)),
+            "depth" => self.max_depth.map_or(ParamValue::Auto, ParamValue::count),
             _ => return None,
         })
     }

@@ -176,8 +176,8 @@ impl ParamSet for OctreeParams {
     }
     fn get(&self, key: &str) -> Option<ParamValue> {
         Some(match key {
-            "leaf" => ParamValue::Int(self.max_leaf_prims as i64),
-            "depth" => ParamValue::Int(self.max_depth as i64),
+            "leaf" => ParamValue::count(self.max_leaf_prims),
+            "depth" => ParamValue::count(self.max_depth),
             "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
             _ => return None,
         })

@@ -152,9 +152,9 @@ impl ParamSet for BottomUpParams {
                 MergeCost::Volume => "volume",
                 MergeCost::Area => "area",
             }),
-            "radius" => ParamValue::Int(self.radius as i64),
-            "greedy-max" => ParamValue::Int(self.greedy_max as i64),
-            "leaf" => ParamValue::Int(self.max_leaf_prims as i64),
+            "radius" => ParamValue::count(self.radius),
+            "greedy-max" => ParamValue::count(self.greedy_max),
+            "leaf" => ParamValue::count(self.max_leaf_prims),
             _ => return None,
         })
     }
