@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::geometry::TriangleMesh;
 use arbor::scene::{build_geometry, MeshSource, SceneDesc, ShapeDesc};
 
@@ -45,7 +45,7 @@ pub fn parse_and_build_scene(data: &[u8], name: &str) {
         return;
     }
     // Errors are fine (an instance of a missing base, say); panics are not.
-    let _ = build_geometry(&desc, &AccelSpec::new(AccelKind::BvhSah));
+    let _ = build_geometry(&desc, &AccelConfig::default());
 }
 
 /// Inline meshes index only their own vertices, and every object's material exists (the renderer

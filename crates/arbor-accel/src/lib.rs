@@ -5,7 +5,13 @@
 //! `(0, t_max)`, and among primitives hit at that same `t`, the one with the lowest index. Triangles are
 //! intersected watertight (Woop, Benthin and Wald 2013), so rays never slip between two triangles that
 //! share an edge.
-#![warn(missing_docs)]
+//!
+//! Start at [`accel::Structure`] (build one with an [`accel::AccelConfig`] over a
+//! [`geometry::TriangleMesh`] made with [`geometry::TriangleMesh::from_arrays`]). The crate's README
+//! follows.
+//!
+#![doc = include_str!("../README.md")]
+#![deny(missing_docs)]
 
 pub mod accel;
 pub mod geometry;

@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use arbor::accel::{AccelKind, AccelSpec, AccelStats, Hit};
+use arbor::accel::{AccelConfig, AccelKind, AccelStats, ConfigError, Hit, KindParam};
 use arbor::bench::{diffuse_rays, framing_camera, mesh_scene, mismatches, primary_rays, sample, sphere_mesh, trace};
 use arbor::math::Ray;
 use arbor::scene::{Scene, SceneDesc};
@@ -73,7 +73,7 @@ fn parse_accel_list(s: &str) -> Result<AccelList, String> {
     }
     let mut kinds: Vec<AccelKind> = Vec::new();
     for name in s.split(',').map(str::trim) {
-        let kind: AccelKind = name.parse()?;
+        let kind: AccelKind = name.parse().map_err(|e: ConfigError| e.to_string())?;
         if !kinds.contains(&kind) {
             kinds.push(kind);
         }
@@ -126,7 +126,7 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     if desc.cameras.is_empty() {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", args.input)).into());
     }
-    let reference = Scene::build(desc.clone(), &AccelSpec::new(REFERENCE), None)?;
+    let reference = Scene::build(desc.clone(), &AccelConfig::from(REFERENCE), None)?;
     let primary = primary_rays(&reference.desc.cameras[0]);
     let (primary_hits, _) = trace(&reference.geometry, &primary);
     let diffuse = diffuse_rays(&reference, &primary, &primary_hits);
@@ -140,24 +140,24 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
 
     eprintln!("bench: tracing a sample with brute force");
     let brute_max = args.brute_rays.map_or((BRUTE_BUDGET / prims.max(1)).clamp(64, 4096), |n| n as usize);
-    let brute_scene = Scene::build(desc.clone(), &AccelSpec::new(AccelKind::Brute), None)?;
+    let brute_scene = Scene::build(desc.clone(), &AccelConfig::Brute, None)?;
     let brute: Vec<SetResult> = sets.iter().map(|s| measure(&brute_scene, s, Some(brute_max), args.runs)).collect();
     let brute_stats = brute_scene.geometry.accel_stats();
     drop(brute_scene);
 
     let mut rows: Vec<(AccelStats, Vec<SetResult>)> = Vec::new();
     for spec in &specs {
-        if spec.kind == AccelKind::Brute {
+        if spec.kind() == AccelKind::Brute {
             let again = sets.iter().map(|s| measure_again(&brute, s)).collect();
-            rows.push((AccelStats { kind: spec.kind.name(), ..brute_stats.clone() }, again));
+            rows.push((AccelStats { kind: spec.kind().name(), ..brute_stats.clone() }, again));
             continue;
         }
         // Progress on standard error: a slow structure should not look like a hang.
-        eprintln!("bench: tracing with {}", spec.kind);
+        eprintln!("bench: tracing with {}", spec.kind());
         let scene = Scene::build(desc.clone(), spec, None)?;
         let results = sets.iter().map(|s| measure(&scene, s, None, args.runs)).collect();
         // Named by what was asked for: a structure may report another's name while it delegates.
-        rows.push((AccelStats { kind: spec.kind.name(), ..scene.geometry.accel_stats() }, results));
+        rows.push((AccelStats { kind: spec.kind().name(), ..scene.geometry.accel_stats() }, results));
     }
     let total_mismatch: usize = rows.iter().flat_map(|(_, r)| r).map(|r| r.mismatches).sum();
     if args.json {
@@ -174,27 +174,22 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// One spec per structure, with the `--accel-param KIND:KEY=VALUE` entries of its kind.
-fn specs(kinds: &[AccelKind], params: &[String]) -> Result<Vec<AccelSpec>, Failure> {
-    let mut per_kind: Vec<(AccelKind, Vec<&str>)> = kinds.iter().map(|&k| (k, Vec::new())).collect();
+/// One configuration per structure, with the `--accel-param KIND:KEY=VALUE` entries of its kind; any
+/// entry that does not parse, names a structure not benchmarked, or does not apply is a usage error.
+fn specs(kinds: &[AccelKind], params: &[String]) -> Result<Vec<AccelConfig>, Failure> {
+    let mut configs: Vec<AccelConfig> = kinds.iter().map(|&k| AccelConfig::from(k)).collect();
     for p in params {
-        let invalid = |msg: String| Failure::Arbor(arbor::Error::Invalid(msg));
-        let (kind, pair) =
-            p.split_once(':').ok_or_else(|| invalid(format!("--accel-param '{p}' is not KIND:KEY=VALUE")))?;
-        let kind: AccelKind = kind.trim().parse().map_err(|e: String| invalid(format!("--accel-param '{p}': {e}")))?;
-        let entry = per_kind.iter_mut().find(|(k, _)| *k == kind);
-        let entry =
-            entry.ok_or_else(|| invalid(format!("--accel-param '{p}': {kind} is not benchmarked (see --accel)")))?;
-        entry.1.push(pair);
+        let usage = |msg: String| Failure::Usage(msg);
+        let param: KindParam = p.parse().map_err(|e| match e {
+            ConfigError::NotKindKeyValue { .. } => usage(format!("--accel-param {e}")),
+            e => usage(format!("--accel-param '{p}': {e}")),
+        })?;
+        let config = configs.iter_mut().find(|c| c.kind() == param.kind);
+        let config = config
+            .ok_or_else(|| usage(format!("--accel-param '{p}': {} is not benchmarked (see --accel)", param.kind)))?;
+        config.set(&param.key, &param.value).map_err(|e| usage(format!("--accel-param '{p}': {e}")))?;
     }
-    per_kind
-        .into_iter()
-        .map(|(kind, pairs)| {
-            let spec = AccelSpec::new(kind).with_params(pairs).map_err(arbor::Error::Invalid)?;
-            spec.check().map_err(arbor::Error::Invalid)?;
-            Ok(spec)
-        })
-        .collect()
+    Ok(configs)
 }
 
 /// The scene to benchmark: a scene file, a mesh file under a default camera, or a generated sphere.

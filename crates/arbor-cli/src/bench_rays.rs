@@ -20,7 +20,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use arbor::accel::{build_with, Accel, AccelSpec, Hit};
+use arbor::accel::{Accel, AccelConfig, Hit};
 use arbor::bench::ray_files::{disagrees, load_ray_set, RaySetFile};
 use arbor::bench::sphere_mesh;
 use arbor::geometry::TriangleMesh;
@@ -39,7 +39,7 @@ const MIN_RUNS: usize = 3;
 const MAX_TIME: Duration = Duration::from_millis(2500);
 
 /// Runs `arbor bench MESH --rays DIR` for the structures of `kinds`.
-pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Failure> {
+pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelConfig]) -> Result<(), Failure> {
     crate::set_threads(args.threads)?;
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads).max(1);
     let path = Path::new(&args.input);
@@ -64,14 +64,14 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
         .collect();
     let warm_up = sphere_mesh(2000);
     for spec in kinds {
-        drop(build_with(spec, &warm_up).map_err(arbor::Error::Invalid)?);
+        drop(spec.build_accel(&warm_up).map_err(|e| Failure::Usage(e.to_string()))?);
         let mut builds = Vec::new();
         let mut cpu_builds = Vec::new();
         let mut accel = None;
         for _ in 0..args.runs {
             drop(accel.take());
             let (start, cpu) = (Instant::now(), cpu_time());
-            let built = build_with(spec, &mesh).map_err(arbor::Error::Invalid)?;
+            let built = spec.build_accel(&mesh).map_err(|e| Failure::Usage(e.to_string()))?;
             builds.push(start.elapsed().as_secs_f64() * 1e3);
             cpu_builds.push((cpu_time() - cpu).as_secs_f64() * 1e3);
             accel = Some(built);
@@ -80,7 +80,7 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
         let build_ms = median(&mut builds);
         let cpu_build_ms = median(&mut cpu_builds);
         let list: Vec<String> = builds.iter().map(|b| format!("{b:.1}")).collect();
-        say!("# peer=arbor-{} built in {} ms", spec.kind, list.join(", "));
+        say!("# peer=arbor-{} built in {} ms", spec.kind(), list.join(", "));
         for (set, batch) in sets.iter().zip(&batches) {
             for mode in [Mode::Single, Mode::Batch] {
                 let r = measure(accel.as_ref(), &mesh, set, batch, threads, mode);
@@ -88,7 +88,7 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelSpec]) -> Result<(), Fail
                     "peer=arbor-{}{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} \
                      tris={} rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} \
                      cpu_mrays={:.3}",
-                    spec.kind,
+                    spec.kind(),
                     mode.suffix(),
                     set.name,
                     r.mrays,

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use arbor::accel::AccelKind;
+use arbor::accel::{AccelConfig, AccelKind};
 use arbor::scene::{LightDesc, MaterialKind, MeshSource, Scene, ShapeDesc};
 use clap::Args;
 
@@ -30,14 +30,10 @@ pub struct InfoArgs {
 /// Runs `arbor info`.
 pub fn run(args: InfoArgs) -> Result<(), Failure> {
     if args.accels {
-        for kind in AccelKind::ALL {
-            say!("{kind}");
-            for (key, what) in kind.param_keys() {
-                say!("    --accel-param {key}=VALUE    {what}");
-            }
-        }
+        list_accels();
         return Ok(());
     }
+    let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
     let desc = crate::render::read_scene(&args.scene)?;
     arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
     say!("scene      {}", crate::shown(&args.scene));
@@ -99,7 +95,6 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     for w in &desc.warnings {
         say!("warning    {w}");
     }
-    let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
     let scene = Scene::build(desc, &spec, None)?;
     let g = &scene.geometry.counts;
     say!(
@@ -122,4 +117,40 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     );
     say!("           SAH cost {:.2}, {:.1} KiB", s.sah_cost, s.bytes as f64 / 1024.0);
     Ok(())
+}
+
+/// `arbor info --accels`: every structure, and under it one line per parameter with its range and
+/// default, in columns aligned across all structures.
+fn list_accels() {
+    let rows: Vec<(AccelKind, Vec<[String; 4]>)> = AccelKind::ALL
+        .iter()
+        .map(|&kind| {
+            let defaults = AccelConfig::from(kind);
+            let rows = kind
+                .params()
+                .iter()
+                .map(|p| {
+                    let default = defaults.get(p.key).map_or_else(String::new, |v| v.to_string());
+                    [format!("{}=VALUE", p.key), p.range.to_string(), default, p.about.to_string()]
+                })
+                .collect();
+            (kind, rows)
+        })
+        .collect();
+    let width = |col: usize| rows.iter().flat_map(|(_, r)| r).map(|r| r[col].len()).max().unwrap_or(0);
+    const HEADING: &str = "structure / --accel-param";
+    // Parameter lines are indented by 4 under their structure's name.
+    let key_w = width(0).max(HEADING.len() - 4);
+    let (range_w, default_w) = (width(1), width(2).max("default".len()));
+    say!("{HEADING:<w$}  {:<range_w$}  {:<default_w$}  meaning", "range", "default", w = key_w + 4);
+    for (kind, params) in &rows {
+        if params.is_empty() {
+            say!("{kind}  (no parameters)");
+            continue;
+        }
+        say!("{kind}");
+        for [key, range, default, about] in params {
+            say!("    {key:<key_w$}  {range:<range_w$}  {default:<default_w$}  {about}");
+        }
+    }
 }

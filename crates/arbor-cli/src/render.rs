@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::{AccelConfig, AccelKind};
 use arbor::farm::{write_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
@@ -89,7 +89,7 @@ pub struct RenderArgs {
 
 /// Parses `--accel`.
 pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
-    s.parse()
+    s.parse().map_err(|e: arbor::accel::ConfigError| e.to_string())
 }
 
 /// Parses `--crop X0,Y0,X1,Y1`.
@@ -136,12 +136,10 @@ impl Signals {
     }
 }
 
-/// The structure and parameters named on the command line.
-pub fn accel_spec(kind: AccelKind, params: &[String]) -> Result<AccelSpec, Failure> {
-    let spec = AccelSpec::new(kind).with_params(params.iter().map(String::as_str)).map_err(arbor::Error::Invalid)?;
-    // Checked now, before any file is read.
-    spec.check().map_err(arbor::Error::Invalid)?;
-    Ok(spec)
+/// The structure and parameters named on the command line; a parameter that does not apply, does not
+/// read or lies outside its range is a usage error, found before any file is read.
+pub fn accel_spec(kind: AccelKind, params: &[String]) -> Result<AccelConfig, Failure> {
+    AccelConfig::from(kind).with_pairs(params.iter().map(String::as_str)).map_err(|e| Failure::Usage(e.to_string()))
 }
 
 /// Reads the scene named on the command line, or the built-in example.
@@ -166,6 +164,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let signals = Signals::install()?;
     crate::set_threads(args.threads)?;
     let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
+    let spec = accel_spec(args.accel, &args.accel_params)?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
     let parse_time = t0.elapsed();
@@ -202,7 +201,6 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     }
     check_limits(&desc, args.spp, &limits(args.no_limits))?;
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
-    let spec = accel_spec(args.accel, &args.accel_params)?;
     let scene = Scene::build(desc, &spec, env)?;
     let cull = if args.cull {
         Some(true)

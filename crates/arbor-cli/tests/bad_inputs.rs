@@ -134,6 +134,24 @@ fn catalogue() -> Vec<Row> {
     // Limits: --spp on the command line, the flag that lifts them, and the other commands.
     cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "error: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     cmd(&["render", "deep_recursion.xml", "--no-limits", "-o", "OUT"], 0, ""),
+    // Structure parameters outside their range, or that do not apply: usage errors (exit 2), found
+    // before the scene is read.
+    cmd(&["render", "no_objects.xml", "--accel-param", "leaf=0", "-o", "OUT"], 2, "error: parameter 'leaf': 0 is outside its range 1..=64\n"),
+    cmd(&["render", "no_objects.xml", "--accel-param", "leaf=1000", "-o", "OUT"], 2, "error: parameter 'leaf': 1000 is outside its range 1..=64\n"),
+    cmd(&["render", "no_objects.xml", "--accel", "bvh-sah", "--accel-param", "bins=1", "-o", "OUT"], 2, "error: parameter 'bins': 1 is outside its range 2..=32\n"),
+    cmd(&["render", "no_objects.xml", "--accel", "octree", "--accel-param", "depth=99", "-o", "OUT"], 2, "error: parameter 'depth': 99 is outside its range 0..=16\n"),
+    cmd(&["render", "no_objects.xml", "--accel", "kdtree", "--accel-param", "empty-bonus=5", "-o", "OUT"], 2, "error: parameter 'empty-bonus': 5 is outside its range 0..=1\n"),
+    cmd(&["render", "no_objects.xml", "--accel", "kdtree", "--accel-param", "traversal-cost=-5", "-o", "OUT"], 2, "error: parameter 'traversal-cost': -5 is outside its range >= 0\n"),
+    cmd(&["render", "no_such_scene.xml", "--accel", "bvh-median", "--accel-param", "leaf=65", "-o", "OUT"], 2, "error: parameter 'leaf': 65 is outside its range 1..=64\n"),
+    cmd(&["render", "no_objects.xml", "--accel-param", "leaf=many", "-o", "OUT"], 2, "error: parameter 'leaf': cannot read 'many' (expected 1..=64)\n"),
+    cmd(&["render", "no_objects.xml", "--accel-param", "depth=3", "-o", "OUT"], 2, "error: bvh-sah has no parameter 'depth' (it has: leaf, bins, traversal-cost, intersection-cost, leaf-block)\n"),
+    cmd(&["render", "no_objects.xml", "--accel", "brute", "--accel-param", "leaf=4", "-o", "OUT"], 2, "error: brute takes no parameters (got 'leaf')\n"),
+    cmd(&["render", "no_objects.xml", "--accel-param", "leaf", "-o", "OUT"], 2, "error: 'leaf' is not KEY=VALUE\n"),
+    cmd(&["info", "no_objects.xml", "--accel", "bvh-bottom-up", "--accel-param", "radius=0"], 2, "error: parameter 'radius': 0 is outside its range 1..=256\n"),
+    cmd(&["info", "no_objects.xml", "--accel", "bvh-bottom-up", "--accel-param", "method=best"], 2, "error: parameter 'method': cannot read 'best' (expected auto|greedy|ploc)\n"),
+    cmd(&["bench", "sphere:100", "--accel", "kdtree", "--accel-param", "kdtree:depth=64"], 2, "error: --accel-param 'kdtree:depth=64': parameter 'depth': 64 is outside its range auto or 0..=63\n"),
+    cmd(&["bench", "sphere:100", "--accel", "octree", "--accel-param", "kdtree:depth=4"], 2, "error: --accel-param 'kdtree:depth=4': kdtree is not benchmarked (see --accel)\n"),
+    cmd(&["bench", "sphere:100", "--accel-param", "depth=4"], 2, "error: --accel-param 'depth=4' is not KIND:KEY=VALUE\n"),
     // Merge: a part that is no partial EXR, or missing.
     cmd(&["merge", "truncated.xml", "-o", "OUT"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
     cmd(&["merge", "no_such_part.exr", "-o", "OUT"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),

@@ -88,6 +88,37 @@ fn cli_usage_error_exits_2() {
 }
 
 #[test]
+fn cli_info_accels_lists_every_parameter_with_range_and_default_in_columns() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = arbor(&["info", "--accels"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().collect();
+    let header = lines[0];
+    let (range_col, default_col, meaning_col) =
+        (header.find("range").unwrap(), header.find("default").unwrap(), header.find("meaning").unwrap());
+    let params: Vec<&str> = lines.iter().copied().filter(|l| l.starts_with("    ")).collect();
+    assert_eq!(params.len(), 3 + 4 + 1 + 5 + 5, "{out}");
+    for l in &params {
+        // Every column starts where its heading does, after at least two spaces.
+        for col in [range_col, default_col, meaning_col] {
+            assert!(l[..col].ends_with("  ") && !l[col..].starts_with(' '), "misaligned at {col}: {l:?}\n{out}");
+        }
+    }
+    let row = |key: &str, kind: &str| {
+        let start = lines.iter().position(|l| *l == kind).unwrap_or_else(|| panic!("no {kind} in\n{out}"));
+        let l = lines[start + 1..].iter().find(|l| l.trim_start().starts_with(key)).unwrap();
+        l.split("  ").map(str::trim).filter(|s| !s.is_empty()).collect::<Vec<_>>()
+    };
+    assert_eq!(row("leaf=", "bvh-sah")[..3], ["leaf=VALUE", "1..=64", "8"]);
+    assert_eq!(row("depth=", "octree")[..3], ["depth=VALUE", "0..=16", "10"]);
+    assert_eq!(row("empty-bonus=", "kdtree")[..3], ["empty-bonus=VALUE", "0..=1", "0.2"]);
+    assert_eq!(row("depth=", "kdtree")[..3], ["depth=VALUE", "auto or 0..=63", "auto"]);
+    assert_eq!(row("method=", "bvh-bottom-up")[..3], ["method=VALUE", "auto|greedy|ploc", "auto"]);
+    assert!(out.contains("brute  (no parameters)"), "{out}");
+}
+
+#[test]
 fn cli_missing_scene_exits_4_naming_the_file() {
     let tmp = tempfile::tempdir().unwrap();
     let o = arbor(&["render", "nowhere.xml"], tmp.path());

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use arbor::accel::{build_with, AccelKind, AccelSpec};
+use arbor::accel::{AccelConfig, AccelKind};
 use arbor::bench::{diffuse_rays, framing_camera, mesh_scene, primary_rays, sphere_mesh, trace};
 use arbor::geometry::TriangleMesh;
 use arbor::math::{Ray, Vec3};
@@ -38,7 +38,7 @@ fn inputs() -> (TriangleMesh, Vec<Ray>, Vec<Ray>) {
     let mesh = two_spheres();
     let camera = framing_camera(mesh.bounds(), SIZE, SIZE);
     let desc = mesh_scene(mesh.clone(), Path::new("sphere"), camera);
-    let scene = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).expect("the sphere scene builds");
+    let scene = Scene::build(desc, &AccelConfig::default(), None).expect("the sphere scene builds");
     let primary = primary_rays(&scene.desc.cameras[0]);
     let (hits, _) = trace(&scene.geometry, &primary);
     let diffuse = diffuse_rays(&scene, &primary, &hits);
@@ -51,7 +51,7 @@ fn build(c: &mut Criterion) {
     g.sample_size(10).throughput(Throughput::Elements(mesh.len() as u64));
     for kind in kinds() {
         g.bench_function(BenchmarkId::from_parameter(kind), |b| {
-            b.iter(|| build_with(&AccelSpec::new(kind), black_box(&mesh)).expect("default parameters"))
+            b.iter(|| AccelConfig::from(kind).build_accel(black_box(&mesh)).expect("default parameters"))
         });
     }
     g.finish();
@@ -63,7 +63,7 @@ fn traverse(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("intersect-{set}"));
         g.sample_size(10).throughput(Throughput::Elements(rays.len() as u64));
         for kind in kinds() {
-            let accel = build_with(&AccelSpec::new(kind), &mesh).expect("default parameters");
+            let accel = AccelConfig::from(kind).build_accel(&mesh).expect("default parameters");
             g.bench_function(BenchmarkId::from_parameter(kind), |b| {
                 b.iter(|| rays.iter().filter(|r| accel.intersect(&mesh, r, f32::INFINITY).is_some()).count())
             });
@@ -75,7 +75,7 @@ fn traverse(c: &mut Criterion) {
         let t_max = vec![f32::INFINITY; rays.len()];
         let mut hits = vec![None; rays.len()];
         for kind in kinds() {
-            let accel = build_with(&AccelSpec::new(kind), &mesh).expect("default parameters");
+            let accel = AccelConfig::from(kind).build_accel(&mesh).expect("default parameters");
             g.bench_function(BenchmarkId::from_parameter(kind), |b| {
                 b.iter(|| {
                     accel.intersect_many(&mesh, rays, &t_max, &mut hits);
@@ -88,7 +88,7 @@ fn traverse(c: &mut Criterion) {
     let mut g = c.benchmark_group("occluded-diffuse");
     g.sample_size(10).throughput(Throughput::Elements(diffuse.len() as u64));
     for kind in kinds() {
-        let accel = build_with(&AccelSpec::new(kind), &mesh).expect("default parameters");
+        let accel = AccelConfig::from(kind).build_accel(&mesh).expect("default parameters");
         g.bench_function(BenchmarkId::from_parameter(kind), |b| {
             b.iter(|| diffuse.iter().filter(|r| accel.occluded(&mesh, r, f32::INFINITY)).count())
         });

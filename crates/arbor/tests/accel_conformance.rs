@@ -723,15 +723,15 @@ const VARIANTS: &[(AccelKind, &[&str])] = &[
 ];
 const VARIANT_RAYS: usize = 10_000;
 
-/// [`check`] for every entry of [`VARIANTS`] (built with `build_with`, validated in debug builds).
+/// [`check`] for every entry of [`VARIANTS`] (built from an `AccelConfig`, validated in debug builds).
 fn check_variants(case: &str, tris: &[[Vec3; 3]], rng: &mut Rng) {
-    use arbor::accel::{build_with, AccelSpec};
+    use arbor::accel::AccelConfig;
     let mesh = mesh_of(tris);
     let probes = Targets::of(&mesh, &tris.concat()).probes(rng, VARIANT_RAYS);
     let brute = build(AccelKind::Brute, &mesh);
     for &(kind, params) in VARIANTS {
-        let spec = AccelSpec::new(kind).with_params(params.iter().copied()).unwrap();
-        let accel = build_with(&spec, &mesh).unwrap();
+        let config = AccelConfig::from(kind).with_pairs(params.iter().copied()).unwrap();
+        let accel = config.build_accel(&mesh).unwrap();
         for p in &probes {
             let (got, want) = (accel.intersect(&mesh, &p.ray, p.t_max), brute.intersect(&mesh, &p.ray, p.t_max));
             assert!(same_hit(got, want), "{kind} {params:?} on {case}: {p:?} hit {got:?}, brute force {want:?}");

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::geometry::TriangleMesh;
 use arbor::math::{Color, Transform, Vec3};
 use arbor::render::{render, RenderOptions};
@@ -67,7 +67,7 @@ fn scene(materials: Vec<MaterialDesc>, objects: Vec<ObjectDesc>, lights: Vec<Lig
 }
 
 fn pixel(desc: SceneDesc) -> Color {
-    let s = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap();
+    let s = Scene::build(desc, &AccelConfig::default(), None).unwrap();
     let (film, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
     film.pixels[0]
 }
@@ -163,7 +163,7 @@ fn analytic_render_is_identical_for_any_thread_count() {
     desc.cameras[0].height = 40;
     desc.cameras[0].window = Window { left: -0.3, right: 0.3, bottom: -0.25, top: 0.25 };
     desc.cameras[0].num_samples = 9;
-    let s = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap();
+    let s = Scene::build(desc, &AccelConfig::default(), None).unwrap();
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| render(&s, 0, &RenderOptions::default(), &|_, _| {}).0)
@@ -188,13 +188,13 @@ fn analytic_environment_seen_directly_and_in_a_mirror() {
     // Nothing in the scene: the camera looks down -z and sees red, in display units whatever the scale.
     let mut desc = scene(vec![], vec![], vec![], 0);
     desc.radiance_scale = 1.0 / 255.0;
-    let s = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), env()).unwrap();
+    let s = Scene::build(desc, &AccelConfig::default(), env()).unwrap();
     let (direct, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
     assert_close(direct.pixels[0], Color::new(0.8, 0.0, 0.0));
     // A mirror facing the camera sends the ray back along +z: blue, times the mirror's reflectance.
     let mirror = material(0.0, 0.0, MaterialKind::Mirror { reflectance: Color::splat(0.5) });
     let desc = scene(vec![mirror], vec![object(quad(0.0, 5.0, true), 0)], vec![], 1);
-    let s = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), env()).unwrap();
+    let s = Scene::build(desc, &AccelConfig::default(), env()).unwrap();
     let (reflected, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
     assert_close(reflected.pixels[0], Color::new(0.0, 0.0, 0.3));
 }

@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 use std::time::Instant;
 
-use arbor::accel::{AccelKind, AccelSpec, TraversalCounts};
+use arbor::accel::{AccelConfig, AccelKind, TraversalCounts};
 use arbor::bench::{framing_camera, mesh_scene, primary_rays, sphere_mesh};
 use arbor::film::Film;
 use arbor::geometry::TriangleMesh;
@@ -22,7 +22,7 @@ use arbor::scene::{load_desc, CameraDesc, Scene, SceneDesc, ShapeDesc, Window};
 const WORK_BUDGET: f64 = 1e8;
 
 fn debug_render(desc: &SceneDesc, kind: AccelKind, view: DebugView) -> (Film, Option<u32>) {
-    let scene = Scene::build(desc.clone(), &AccelSpec::new(kind), None).unwrap_or_else(|e| panic!("{e}"));
+    let scene = Scene::build(desc.clone(), &AccelConfig::from(kind), None).unwrap_or_else(|e| panic!("{e}"));
     let opts = RenderOptions { debug: Some(view), ..Default::default() };
     let (film, stats) = render(&scene, 0, &opts, &|_, _| {});
     (film, stats.heatmap_max)
@@ -89,7 +89,7 @@ fn debug_primid_identical_across_structures_on_reference_scenes() {
         let (reference, _) = debug_render(&desc, AccelKind::BvhSah, DebugView::PrimId);
         let bytes = reference.to_rgb8();
         for &kind in AccelKind::ALL.iter().filter(|&&k| k != AccelKind::BvhSah) {
-            let scene = Scene::build(desc.clone(), &AccelSpec::new(kind), None).unwrap_or_else(|e| panic!("{e}"));
+            let scene = Scene::build(desc.clone(), &AccelConfig::from(kind), None).unwrap_or_else(|e| panic!("{e}"));
             let work = estimated_work(&scene);
             compared += 1;
             if work > WORK_BUDGET {

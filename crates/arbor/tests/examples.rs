@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::mesh_io::load_mesh;
 use arbor::render::{render, RenderOptions};
 use arbor::scene::{load_desc, Scene};
@@ -26,7 +26,7 @@ fn examples_load_build_and_render() {
         for cam in &mut desc.cameras {
             (cam.width, cam.height) = (cam.width / 8, cam.height / 8);
         }
-        let scene = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap_or_else(|e| panic!("{e}"));
+        let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
         let (film, _) = render(&scene, 0, &RenderOptions::default(), &|_, _| {});
         let lit = film.pixels.iter().filter(|c| c.max_element() > 0.1).count();
         assert!(lit * 4 > film.pixels.len(), "{}: mostly dark", path.display());

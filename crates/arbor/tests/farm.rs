@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::farm::{merge, read_partial, tile_window, write_partial, Partial};
 use arbor::film::Film;
 use arbor::render::{render, render_sums, RenderOptions};
@@ -18,7 +18,7 @@ fn example() -> Scene {
         (c.width, c.height) = (c.width / 8, c.height / 8 + 3);
     }
     assert_eq!(desc.cameras[0].num_samples, 4);
-    Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap()
+    Scene::build(desc, &AccelConfig::default(), None).unwrap()
 }
 
 fn bits(film: &Film) -> Vec<u32> {

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::geometry::TriangleMesh;
 use arbor::integrator::offset::spawn_origin;
 use arbor::math::{Color, Ray, Transform, Vec3};
@@ -44,7 +44,7 @@ fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {
         kind: MaterialKind::BlinnPhong,
     });
     d.objects = objects;
-    Scene::build(d, &AccelSpec::new(AccelKind::BvhSah), None).unwrap()
+    Scene::build(d, &AccelConfig::default(), None).unwrap()
 }
 
 fn mesh(positions: Vec<Vec3>, indices: Vec<[u32; 3]>) -> ShapeDesc {
@@ -208,7 +208,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             lens: None,
             loc: Location::file("test"),
         });
-        let s = Scene::build(d, &AccelSpec::new(AccelKind::BvhSah), None).unwrap();
+        let s = Scene::build(d, &AccelConfig::default(), None).unwrap();
         images.push(render(&s, 0, &RenderOptions::default(), &|_, _| {}).0);
     }
     let lit = images[1].pixels.iter().filter(|c| c.x > 0.05).count();

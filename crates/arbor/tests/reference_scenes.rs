@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::image_io::metrics::compare_rgb8;
 use arbor::image_io::read_rgb8;
 use arbor::render::{render, RenderOptions};
@@ -49,7 +49,7 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>) -> (String, Vec<Stri
     for case in cases {
         if current.as_ref().is_none_or(|(p, _)| *p != case.scene) {
             let desc = load_desc(&case.scene).unwrap_or_else(|e| panic!("{e}"));
-            let scene = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap_or_else(|e| panic!("{e}"));
+            let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
             current = Some((case.scene.clone(), scene));
         }
         let scene = &current.as_ref().unwrap().1;

@@ -12,7 +12,7 @@ mod common;
 
 use std::path::Path;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::AccelConfig;
 use arbor::film::Film;
 use arbor::render::{render, RenderOptions};
 use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
@@ -38,7 +38,7 @@ fn bits(film: &Film) -> Vec<u32> {
 
 /// Renders every camera of `desc` with 1 and 2 threads; returns the names of those that differ.
 fn compare_threads(name: &str, desc: SceneDesc, opts: &RenderOptions) -> Vec<String> {
-    let scene = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap_or_else(|e| panic!("{e}"));
+    let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
     let mut differ = Vec::new();
     for camera in 0..scene.desc.cameras.len() {
         for cull in [false, true] {
@@ -99,7 +99,7 @@ fn example() -> Scene {
     let desc = parse_desc(text, Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/cornell_box.xml")));
     let desc = shrink(desc.unwrap_or_else(|e| panic!("{e}")), 4);
     assert!(desc.cameras[0].num_samples > 1);
-    Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap()
+    Scene::build(desc, &AccelConfig::default(), None).unwrap()
 }
 
 /// The pixels `x0..x1` x `y0..y1` of `film`.

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use arbor::accel::{AccelKind, AccelSpec};
+use arbor::accel::{AccelConfig, AccelKind};
 use arbor::geometry::TriangleMesh;
 use arbor::math::{Color, Ray, Transform, Vec3};
 use arbor::scene::{build_geometry, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
@@ -49,7 +49,7 @@ fn two_level_instance_shares_geometry_and_is_hit_through_its_transform() {
         object("Mesh 1", mesh, Transform::IDENTITY),
         object("MeshInstance 1", ShapeDesc::Instance { base: 0 }, moved),
     ]);
-    let g = build_geometry(&d, &AccelSpec::new(AccelKind::BvhSah)).unwrap();
+    let g = build_geometry(&d, &AccelConfig::default()).unwrap();
     assert_eq!(g.meshes.len(), 1, "the instance must not copy the mesh");
     assert_eq!((g.counts.triangles, g.counts.unique_triangles, g.counts.objects), (4, 2, 2));
     // The instance sits around (0, 10, 0) after the rotation of its translation.
@@ -101,10 +101,10 @@ fn two_level_every_structure_matches_brute_force_on_random_transformed_scenes() 
     let mut rays_checked = 0;
     for _ in 0..4 {
         let d = random_scene(&mut rng);
-        let brute = build_geometry(&d, &AccelSpec::new(AccelKind::Brute)).unwrap();
+        let brute = build_geometry(&d, &AccelConfig::from(AccelKind::Brute)).unwrap();
         let rays: Vec<Ray> = (0..5_000).map(|_| Ray::new(rng.v(30.0), rng.v(2.0))).collect();
         for &kind in AccelKind::ALL {
-            let g = build_geometry(&d, &AccelSpec::new(kind)).unwrap();
+            let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
             for ray in &rays {
                 let (want, got) = (brute.intersect(ray, f32::INFINITY), g.intersect(ray, f32::INFINITY));
                 assert_eq!(want.map(|h| (h.prim, h.sub, h.t)), got.map(|h| (h.prim, h.sub, h.t)), "{kind} on {ray:?}");
@@ -123,7 +123,7 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
     // primitive, at the same distance up to rounding (rays are transformed instead of triangles).
     let mut rng = Lcg(11);
     let d = random_scene(&mut rng);
-    let g = build_geometry(&d, &AccelSpec::new(AccelKind::BvhSah)).unwrap();
+    let g = build_geometry(&d, &AccelConfig::default()).unwrap();
     let flat_objects: Vec<ObjectDesc> = d
         .objects
         .iter()
@@ -147,7 +147,7 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
             _ => o.clone(),
         })
         .collect();
-    let flat = build_geometry(&desc(flat_objects), &AccelSpec::new(AccelKind::BvhSah)).unwrap();
+    let flat = build_geometry(&desc(flat_objects), &AccelConfig::default()).unwrap();
     let (mut agree, mut total) = (0, 0);
     for _ in 0..20_000 {
         let ray = Ray::new(rng.v(30.0), rng.v(2.0));
@@ -199,7 +199,7 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         rays[10] = Ray::new(Vec3::NAN, Vec3::X);
         rays[11] = Ray::new(Vec3::ZERO, Vec3::ZERO);
         for &kind in AccelKind::ALL {
-            let g = build_geometry(&d, &AccelSpec::new(kind)).unwrap();
+            let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
             for t_max in [f32::INFINITY, 20.0] {
                 let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
                 assert!(single.iter().filter(|h| h.is_some()).count() > 200, "{kind}: the rays must hit");

@@ -183,7 +183,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
     desc.objects.push(object(ShapeDesc::Sphere { center: Vec3::new(3.0, 0.0, 0.0), radius: 1.0 }));
     desc.objects.push(object(ShapeDesc::Plane { point: Vec3::new(0.0, -2.0, 0.0), normal: Vec3::Y }));
     for &kind in AccelKind::ALL {
-        let scene = Scene::build(desc.clone(), &arbor::accel::AccelSpec::new(kind), None).unwrap();
+        let scene = Scene::build(desc.clone(), &arbor::accel::AccelConfig::from(kind), None).unwrap();
         for ray in bad_rays() {
             assert!(scene.geometry.intersect(&ray, f32::INFINITY).is_none(), "scene {kind} hit with {ray:?}");
             assert!(!scene.geometry.occluded(&ray, f32::INFINITY), "scene {kind} occluded with {ray:?}");

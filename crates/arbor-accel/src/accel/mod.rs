@@ -1,21 +1,28 @@
-//! Acceleration structures: one contract ([`Accel`]) in the vocabulary of pbrt and Embree, over any set
-//! of bounded primitives ([`Primitives`]), and one factory ([`build`], [`build_with`]) selected by
-//! [`AccelKind`] and tuned by each structure's `*Params` ([`AccelSpec`]).
+//! Acceleration structures. The public door is [`Structure`]: a structure built by an [`AccelConfig`]
+//! (which structure, and its `*Params`) over primitives it holds, a [`crate::geometry::TriangleMesh`] or
+//! anything that implements [`Primitives`], answering closest-hit and any-hit queries.
 //!
 //! Every structure returns exactly the hit brute force returns: the smallest `t` in `(0, t_max)`, and
-//! among primitives hit at that same `t`, the one with the lowest index. Structures store only primitive
-//! indices; the primitives themselves are passed to each query, which keeps builders free of geometry
-//! and lets one structure type serve triangles, spheres or whole objects (the two-level scene).
+//! among primitives hit at that same `t`, the one with the lowest index. Inside, structures store only
+//! primitive indices and are given the primitives with each query (the hidden `Accel` contract in the
+//! vocabulary of pbrt and Embree), which keeps builders free of geometry and lets one structure type
+//! serve triangles, spheres or whole objects (the renderer's two-level scene); [`Structure`] pairs a
+//! structure with its primitives so that it cannot be asked about others.
 //!
 //! One folder per structure: `brute.rs`, `octree/`, `kdtree/`, `bvh/` (median, binned SAH and bottom-up
-//! builders sharing one node layout and one traversal).
+//! builders sharing one node layout and one traversal). Their node layouts are not part of the API.
 
 mod brute;
+#[doc(hidden)]
 pub mod bvh;
+mod config;
+#[doc(hidden)]
 pub mod kdtree;
 mod mesh_prims;
+#[doc(hidden)]
 pub mod octree;
 mod params;
+mod structure;
 
 use std::fmt;
 use std::str::FromStr;
@@ -23,11 +30,22 @@ use std::time::Duration;
 
 use crate::math::{Aabb, Ray, Vec3};
 
+#[doc(hidden)]
 pub use brute::BruteForce;
-pub use bvh::{BottomUpParams, Bvh, BvhParams, MedianParams};
-pub use kdtree::{KdTree, KdTreeParams};
-pub use octree::{Octree, OctreeParams};
-pub use params::{AccelSpec, Params};
+#[doc(hidden)]
+pub use bvh::Bvh;
+pub use bvh::{BottomUpMethod, BottomUpParams, BvhParams, MedianParams, MergeCost};
+pub use config::{AccelConfig, ConfigError, KindParam};
+#[doc(hidden)]
+pub use kdtree::KdTree;
+pub use kdtree::KdTreeParams;
+#[doc(hidden)]
+pub use octree::Octree;
+pub use octree::OctreeParams;
+#[doc(hidden)]
+pub use params::ParamSet;
+pub use params::{ParamRange, ParamSpec, ParamValue};
+pub use structure::{Structure, ValidateError};
 
 /// How much every structure widens its box and interval tests, relative to the extent in `t` of the box
 /// (or root) along the ray's major axis: 2^-16, about 128 ulps.
@@ -94,6 +112,39 @@ impl Hit {
 }
 
 /// What a structure indexes: a set of bounded primitives addressed by index `0..len()`.
+///
+/// [`crate::geometry::TriangleMesh`] implements it; so can any other shape. Spheres, for example:
+///
+/// ```
+/// use arbor_accel::accel::{AccelConfig, PrimHit, Primitives, Structure};
+/// use arbor_accel::geometry::Sphere;
+/// use arbor_accel::math::{Aabb, Ray, Transform, Vec3};
+///
+/// struct Balls(Vec<Sphere>);
+///
+/// impl Primitives for Balls {
+///     fn len(&self) -> usize {
+///         self.0.len()
+///     }
+///     fn bounds(&self, i: usize) -> Aabb {
+///         self.0[i].bounds()
+///     }
+///     fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
+///         self.0[i].intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
+///     }
+/// }
+///
+/// let ball = |x: f32| Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 0.5, transform: Transform::IDENTITY };
+/// let balls = Balls((0..100).map(|i| ball(i as f32)).collect());
+/// let structure = Structure::build(&"kdtree".parse()?, balls)?;
+/// let along_x = Ray::new(Vec3::new(-10.0, 0.0, 0.0), Vec3::X);
+/// let hit = structure.intersect(&along_x, f32::INFINITY).unwrap();
+/// assert_eq!(hit.prim, 0);
+/// assert!((hit.t - 9.5).abs() < 1e-5);
+/// let from_above = Ray::new(Vec3::new(42.0, 5.0, 0.0), -Vec3::Y);
+/// assert_eq!(structure.intersect(&from_above, f32::INFINITY).unwrap().prim, 42);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub trait Primitives: Sync {
     /// Number of primitives.
     fn len(&self) -> usize;
@@ -116,6 +167,7 @@ pub trait Primitives: Sync {
     }
     /// [`Primitives::intersect`], adding the work done to `counts` (one primitive test by default; a
     /// primitive that is itself a structure, as objects of the two-level scene are, adds its traversal).
+    #[doc(hidden)]
     fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {
         counts.prims += 1;
         self.intersect(i, ray, t_max)
@@ -133,12 +185,14 @@ pub trait Primitives: Sync {
     /// The triangle mesh these primitives are, when they are one (primitive `i` is triangle `i`): lets a
     /// structure keep the triangles' corners in its own leaf order and test them without going through
     /// [`Primitives::intersect`], with the same triangle test and so the same hits.
+    #[doc(hidden)]
     fn triangle_mesh(&self) -> Option<&crate::geometry::TriangleMesh> {
         None
     }
 }
 
 /// The work one query did, for the traversal-cost heatmap and benchmarks.
+#[doc(hidden)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct TraversalCounts {
     /// Nodes (cells) visited.
@@ -175,7 +229,9 @@ pub struct AccelStats {
     pub build_time: Duration,
 }
 
-/// The contract every acceleration structure meets.
+/// The contract every acceleration structure meets: the primitives come with each query. Internal (the
+/// renderer's two-level scene and the benchmarks); [`Structure`] is the public door.
+#[doc(hidden)]
 pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
     /// Bounds of everything indexed.
     fn bounds(&self) -> Aabb;
@@ -210,6 +266,7 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
 
 /// The structures Arbor can build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum AccelKind {
     /// Tests every primitive: the reference.
     Brute,
@@ -248,16 +305,23 @@ impl AccelKind {
         }
     }
 
-    /// The build parameters this kind takes (`--accel-param KEY=VALUE`), with what they mean.
-    pub fn param_keys(self) -> &'static [(&'static str, &'static str)] {
-        match self {
-            AccelKind::Brute => &[],
-            AccelKind::Octree => OctreeParams::KEYS,
-            AccelKind::KdTree => KdTreeParams::KEYS,
-            AccelKind::BvhMedian => MedianParams::KEYS,
-            AccelKind::BvhSah => BvhParams::KEYS,
-            AccelKind::BvhBottomUp => BottomUpParams::KEYS,
-        }
+    /// The build parameters this kind takes (`--accel-param KEY=VALUE`): what they mean and their
+    /// ranges. Their defaults are the values of `AccelConfig::from(kind)`.
+    ///
+    /// ```
+    /// use arbor_accel::accel::{AccelConfig, AccelKind};
+    ///
+    /// let kind = AccelKind::KdTree;
+    /// let defaults = AccelConfig::from(kind);
+    /// for p in kind.params() {
+    ///     println!("{:<18} {:<16} {:<8} {}", p.key, p.range, defaults.get(p.key).unwrap(), p.about);
+    /// }
+    /// assert_eq!(kind.params().iter().map(|p| p.key).collect::<Vec<_>>(),
+    ///            ["traversal-cost", "intersection-cost", "empty-bonus", "depth"]);
+    /// assert!(AccelKind::Brute.params().is_empty());
+    /// ```
+    pub fn params(self) -> &'static [ParamSpec] {
+        AccelConfig::from(self).params()
     }
 }
 
@@ -268,55 +332,23 @@ impl fmt::Display for AccelKind {
 }
 
 impl FromStr for AccelKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        AccelKind::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| {
-            let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown acceleration structure '{s}' (expected one of: {})", names.join(", "))
-        })
+    type Err = ConfigError;
+    fn from_str(s: &str) -> Result<Self, ConfigError> {
+        let name = s.trim();
+        AccelKind::ALL
+            .iter()
+            .copied()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| ConfigError::UnknownKind { name: name.to_string() })
     }
 }
 
-impl AccelSpec {
-    /// Checks that every parameter applies to the kind and parses, without building anything.
-    pub fn check(&self) -> Result<(), String> {
-        match self.kind {
-            AccelKind::Brute => self.parse::<params::NoParams>().map(drop),
-            AccelKind::Octree => self.parse::<OctreeParams>().map(drop),
-            AccelKind::KdTree => self.parse::<KdTreeParams>().map(drop),
-            AccelKind::BvhMedian => self.parse::<MedianParams>().map(drop),
-            AccelKind::BvhSah => self.parse::<BvhParams>().map(drop),
-            AccelKind::BvhBottomUp => self.parse::<BottomUpParams>().map(drop),
-        }
-    }
-}
-
-/// Builds a structure of `kind` with its default parameters over `prims` (pbrt's `CreateAccelerator`).
-/// In debug builds the result is validated before it is returned.
+/// Builds a structure of `kind` with its default parameters over `prims` (pbrt's `CreateAccelerator`),
+/// behind the internal contract. In debug builds the result is validated before it is returned.
+#[doc(hidden)]
 pub fn build<P: Primitives + ?Sized + 'static>(kind: AccelKind, prims: &P) -> Box<dyn Accel<P>> {
-    match build_with(&AccelSpec::new(kind), prims) {
+    match AccelConfig::from(kind).build_accel(prims) {
         Ok(accel) => accel,
         Err(e) => unreachable!("default parameters are always valid: {e}"),
     }
-}
-
-/// Builds the structure `spec` describes over `prims`; an error names a parameter that does not apply
-/// or does not parse. In debug builds the result is validated before it is returned.
-pub fn build_with<P: Primitives + ?Sized + 'static>(spec: &AccelSpec, prims: &P) -> Result<Box<dyn Accel<P>>, String> {
-    let accel: Box<dyn Accel<P>> = match spec.kind {
-        AccelKind::Brute => {
-            spec.parse::<params::NoParams>()?;
-            Box::new(BruteForce::build(prims))
-        }
-        AccelKind::Octree => Box::new(Octree::build(prims, &spec.parse()?)),
-        AccelKind::KdTree => Box::new(KdTree::build(prims, &spec.parse()?)),
-        AccelKind::BvhMedian => Box::new(Bvh::build_median(prims, &spec.parse()?)),
-        AccelKind::BvhSah => Box::new(Bvh::build_sah(prims, &spec.parse()?)),
-        AccelKind::BvhBottomUp => Box::new(Bvh::build_bottom_up(prims, &spec.parse()?)),
-    };
-    #[cfg(debug_assertions)]
-    if let Err(e) = accel.validate(prims) {
-        panic!("{} built an invalid structure: {e}", spec.kind);
-    }
-    Ok(accel)
 }

@@ -1,4 +1,8 @@
 //! Indexed triangle meshes stored as flat arrays, as loaders produce them and the scene consumes them.
+//! [`TriangleMesh::from_arrays`] is the checked way in from plain arrays: indices out of range and
+//! non-finite positions are a [`MeshError`], not a panic later in a build or a query.
+
+use std::fmt;
 
 use crate::math::{Aabb, Transform, Vec2, Vec3};
 
@@ -22,7 +26,92 @@ pub struct MeshReport {
     pub degenerate: usize,
 }
 
+/// Why [`TriangleMesh::from_arrays`] (or [`TriangleMesh::validate`]) refused a mesh.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum MeshError {
+    /// A triangle names a vertex that does not exist.
+    IndexOutOfRange {
+        /// The triangle (its index in the triangle array).
+        triangle: usize,
+        /// Which of its three corners (0, 1 or 2).
+        corner: usize,
+        /// The vertex index it names.
+        index: u32,
+        /// How many vertices there are.
+        vertices: usize,
+    },
+    /// A vertex has a NaN or infinite coordinate.
+    NonFinitePosition {
+        /// The vertex (its index in the position array).
+        vertex: usize,
+        /// Its coordinates.
+        position: [f32; 3],
+    },
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MeshError::IndexOutOfRange { triangle, corner, index, vertices } => write!(
+                f,
+                "triangle {triangle}: corner {corner} names vertex {index}, but there are only {vertices} vertices"
+            ),
+            MeshError::NonFinitePosition { vertex, position: [x, y, z] } => {
+                write!(f, "vertex {vertex}: position ({x}, {y}, {z}) is not finite")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
 impl TriangleMesh {
+    /// A mesh from vertex positions and triangles given as three 0-based indices into `positions`,
+    /// counter-clockwise around the outward normal. Without normals or texture coordinates.
+    ///
+    /// ```
+    /// use arbor_accel::geometry::{MeshError, TriangleMesh};
+    ///
+    /// let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let mesh = TriangleMesh::from_arrays(positions.clone(), vec![[0, 1, 2]])?;
+    /// assert_eq!(mesh.len(), 1);
+    ///
+    /// let err = TriangleMesh::from_arrays(positions, vec![[0, 1, 3]]).unwrap_err();
+    /// assert!(matches!(err, MeshError::IndexOutOfRange { triangle: 0, corner: 2, index: 3, vertices: 3 }));
+    /// assert_eq!(err.to_string(), "triangle 0: corner 2 names vertex 3, but there are only 3 vertices");
+    /// # Ok::<(), MeshError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`MeshError::IndexOutOfRange`] for the first index past the end of `positions`,
+    /// [`MeshError::NonFinitePosition`] for the first position with a NaN or infinite coordinate.
+    pub fn from_arrays(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Result<TriangleMesh, MeshError> {
+        let mesh = TriangleMesh {
+            positions: positions.into_iter().map(Vec3::from).collect(),
+            indices: triangles,
+            normals: None,
+            uvs: None,
+        };
+        mesh.validate()?;
+        Ok(mesh)
+    }
+
+    /// Checks that every index names a vertex and every position is finite (what
+    /// [`TriangleMesh::from_arrays`] guarantees, for meshes whose fields were filled directly).
+    pub fn validate(&self) -> Result<(), MeshError> {
+        if let Some((vertex, p)) = self.positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(MeshError::NonFinitePosition { vertex, position: p.to_array() });
+        }
+        let vertices = self.positions.len();
+        for (triangle, t) in self.indices.iter().enumerate() {
+            if let Some(corner) = t.iter().position(|&i| i as usize >= vertices) {
+                return Err(MeshError::IndexOutOfRange { triangle, corner, index: t[corner], vertices });
+            }
+        }
+        Ok(())
+    }
+
     /// Number of triangles.
     pub fn len(&self) -> usize {
         self.indices.len()
@@ -117,6 +206,42 @@ mod tests {
         let m = quad().transformed(&Transform::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap());
         let [a, b, c] = m.triangle(0);
         assert!((b - a).cross(c - a).z > 0.0);
+    }
+
+    #[test]
+    fn mesh_from_arrays_keeps_the_arrays() {
+        let m = TriangleMesh::from_arrays(
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap();
+        assert_eq!(m, quad());
+        let empty = TriangleMesh::from_arrays(Vec::new(), Vec::new()).unwrap();
+        assert!(empty.is_empty() && empty.bounds().is_empty());
+    }
+
+    #[test]
+    fn mesh_from_arrays_refuses_indices_out_of_range() {
+        let square = || vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let err = TriangleMesh::from_arrays(square(), vec![[0, 1, 2], [0, 4, u32::MAX]]).unwrap_err();
+        assert_eq!(err, MeshError::IndexOutOfRange { triangle: 1, corner: 1, index: 4, vertices: 4 });
+        assert_eq!(err.to_string(), "triangle 1: corner 1 names vertex 4, but there are only 4 vertices");
+        let err = TriangleMesh::from_arrays(Vec::new(), vec![[0, 0, 0]]).unwrap_err();
+        assert_eq!(err.to_string(), "triangle 0: corner 0 names vertex 0, but there are only 0 vertices");
+    }
+
+    #[test]
+    fn mesh_from_arrays_refuses_non_finite_positions() {
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let err = TriangleMesh::from_arrays(vec![[0.0; 3], [1.0, bad, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]])
+                .unwrap_err();
+            assert!(
+                matches!(err, MeshError::NonFinitePosition { vertex: 1, position: [x, _, z] } if x == 1.0 && z == 0.0)
+            );
+            assert_eq!(err.to_string(), format!("vertex 1: position (1, {bad}, 0) is not finite"));
+        }
+        let e: Box<dyn std::error::Error> = Box::new(MeshError::NonFinitePosition { vertex: 0, position: [0.0; 3] });
+        assert!(e.to_string().starts_with("vertex 0"));
     }
 
     #[test]

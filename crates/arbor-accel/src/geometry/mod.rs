@@ -1,5 +1,6 @@
 //! Shapes and their ray intersection: triangle meshes (flat arrays), spheres, infinite planes.
 
+#[doc(hidden)]
 pub mod error_bound;
 mod mesh;
 mod plane;
@@ -9,10 +10,14 @@ mod triangle4;
 mod triangle_box;
 mod triangle_clip;
 
-pub use mesh::{MeshReport, TriangleMesh};
+pub use mesh::{MeshError, MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;
-pub use triangle::{intersect_triangle, intersect_triangle_in, major_axis, RayFrame, TriHit};
+pub use triangle::{intersect_triangle, TriHit};
+// The ray frames and SIMD lanes of the traversal kernels: shared with the structures, not an API.
+#[doc(hidden)]
+pub use triangle::{intersect_triangle_in, major_axis, RayFrame};
+#[doc(hidden)]
 pub use triangle4::{intersect_triangles4, Tri4, Tri4Hits};
 pub use triangle_box::triangle_overlaps_box;
 pub use triangle_clip::clip_triangle_bounds;

@@ -173,7 +173,7 @@ pub fn mismatches(a: &[Option<Hit>], b: &[Option<Hit>]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::{AccelKind, AccelSpec};
+    use crate::accel::AccelConfig;
 
     #[test]
     fn bench_sphere_has_about_n_unit_triangles() {
@@ -195,7 +195,7 @@ mod tests {
     fn bench_framing_camera_sees_the_whole_mesh_and_diffuse_rays_leave_it() {
         let mesh = sphere_mesh(2000);
         let desc = mesh_scene(mesh.clone(), Path::new("sphere"), framing_camera(mesh.bounds(), 48, 32));
-        let scene = Scene::build(desc, &AccelSpec::new(AccelKind::BvhSah), None).unwrap();
+        let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap();
         let rays = primary_rays(&scene.desc.cameras[0]);
         assert_eq!(rays.len(), 48 * 32);
         let (hits, _) = trace(&scene.geometry, &rays);

@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
-use crate::accel::{self, Accel, AccelSpec, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
+use crate::accel::{Accel, AccelConfig, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::{Error, Result};
@@ -340,8 +340,8 @@ fn world_box(b: &Aabb, t: Option<&Transform>) -> Aabb {
 
 /// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes, at both
 /// levels.
-pub fn build_geometry(desc: &SceneDesc, spec: &AccelSpec) -> Result<SceneGeometry> {
-    spec.check().map_err(Error::Invalid)?;
+pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeometry> {
+    spec.check().map_err(|e| Error::Invalid(e.to_string()))?;
     let start = Instant::now();
     let files = load_mesh_files(desc)?;
     let mesh_load = start.elapsed();
@@ -407,13 +407,13 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelSpec) -> Result<SceneGeometr
     counts.degenerate = shapes.iter().map(|s| s.mesh.check().degenerate).sum();
     counts.planes = planes.len();
     counts.objects = objects.len();
-    let top = accel::build_with(spec, &objects).map_err(Error::Invalid)?;
+    let top = spec.build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
 }
 
 /// A mesh ready for rendering: smooth meshes get vertex normals (from the file, or averaged from the
 /// faces), flat ones none (the shader then uses the face normal).
-fn mesh_shape(mesh: &TriangleMesh, smooth: bool, spec: &AccelSpec) -> MeshShape {
+fn mesh_shape(mesh: &TriangleMesh, smooth: bool, spec: &AccelConfig) -> MeshShape {
     let mut mesh = TriangleMesh { uvs: None, ..mesh.clone() };
     if smooth {
         match &mut mesh.normals {
@@ -423,7 +423,7 @@ fn mesh_shape(mesh: &TriangleMesh, smooth: bool, spec: &AccelSpec) -> MeshShape 
     } else {
         mesh.normals = None;
     }
-    let accel = match accel::build_with(spec, &mesh) {
+    let accel = match spec.build_accel(&mesh) {
         Ok(a) => a,
         Err(e) => unreachable!("parameters were checked before building: {e}"),
     };

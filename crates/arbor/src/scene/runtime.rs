@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::build::{build_geometry, SceneGeometry, Shape};
 use super::desc::{MaterialDesc, OffsetRule, SceneDesc};
-use crate::accel::{AccelSpec, Hit};
+use crate::accel::{AccelConfig, Hit};
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
@@ -45,7 +45,7 @@ pub struct Surface {
 
 impl Scene {
     /// Loads the meshes and builds the structure. `environment` overrides the scene's own map.
-    pub fn build(desc: SceneDesc, spec: &AccelSpec, environment: Option<EnvMap>) -> Result<Scene> {
+    pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
             None => match desc.environment.as_deref() {

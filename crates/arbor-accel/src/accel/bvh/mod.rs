@@ -37,8 +37,8 @@ use std::time::{Duration, Instant};
 pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 pub use wide::{Node8, Wide};
 
-use super::params::{parse_value, unknown_key};
-use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
+use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
+use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
 /// Largest number of primitives in one leaf, whatever the parameters: a leaf of coincident centroids
@@ -104,17 +104,18 @@ impl Node {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BvhParams {
     /// A node with more primitives is always split; one with at most this many becomes a leaf when
-    /// splitting does not lower the SAH cost (median build: always). Clamped to `1..=LEAF_HARD_MAX`.
+    /// splitting does not lower the SAH cost (median build: always). Valid: `1..=64` (`LEAF_HARD_MAX`);
+    /// the builder clamps values set directly.
     pub max_leaf_prims: usize,
-    /// Number of SAH bins along the split axis. Clamped to `2..=MAX_BINS`.
+    /// Number of SAH bins along the split axis. Valid: `2..=32` (`MAX_BINS`).
     pub bins: usize,
-    /// Cost of visiting one node, relative to `intersection_cost`.
+    /// Cost of visiting one node, relative to `intersection_cost`. Valid: finite, `>= 0`.
     pub traversal_cost: f32,
-    /// Cost of intersecting one primitive, or one block of `leaf_block` triangles.
+    /// Cost of intersecting one primitive, or one block of `leaf_block` triangles. Valid: finite, `>= 0`.
     pub intersection_cost: f32,
     /// Triangles a leaf tests at once (the SIMD lanes of `wide::LeafBlock`): the SAH counts a leaf's
     /// primitives in blocks of this many, so that it prefers full blocks. Triangle meshes only; other
-    /// primitives are tested one at a time and always count as blocks of one. Clamped to `1..=8`.
+    /// primitives are tested one at a time and always count as blocks of one. Valid: `1..=8`.
     pub leaf_block: usize,
 }
 
@@ -149,31 +150,69 @@ impl BvhParams {
     }
 }
 
-impl Params for BvhParams {
-    const KEYS: &'static [(&'static str, &'static str)] = &[
-        ("leaf", "most primitives in a leaf that the SAH may keep (1-64)"),
-        ("bins", "SAH bins along the split axis (2-32)"),
-        ("traversal-cost", "cost of a node visit relative to a primitive test"),
-        ("intersection-cost", "cost of a primitive test (of a block of triangles)"),
-        ("leaf-block", "triangles tested at once in a leaf, counted as one test by the SAH (1-8)"),
+/// A leaf's primitive count, as every BVH builder accepts it.
+const LEAF_RANGE: ParamRange = ParamRange::Int { min: 1, max: Some(LEAF_HARD_MAX as i64) };
+/// A cost of the SAH: any finite, non-negative number.
+const COST_RANGE: ParamRange = ParamRange::Float { min: 0.0, max: None };
+
+impl BvhParams {
+    /// The parameters by key, with their ranges.
+    pub const PARAMS: &'static [ParamSpec] = &[
+        ParamSpec { key: "leaf", about: "most primitives in a leaf that the SAH may keep", range: LEAF_RANGE },
+        ParamSpec {
+            key: "bins",
+            about: "SAH bins along the split axis",
+            range: ParamRange::Int { min: 2, max: Some(MAX_BINS as i64) },
+        },
+        ParamSpec {
+            key: "traversal-cost",
+            about: "cost of a node visit relative to a primitive test",
+            range: COST_RANGE,
+        },
+        ParamSpec {
+            key: "intersection-cost",
+            about: "cost of a primitive test (of a block of triangles)",
+            range: COST_RANGE,
+        },
+        ParamSpec {
+            key: "leaf-block",
+            about: "triangles tested at once in a leaf, counted as one test by the SAH",
+            range: ParamRange::Int { min: 1, max: Some(8) },
+        },
     ];
-    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
+}
+
+impl ParamSet for BvhParams {
+    fn specs(&self) -> &'static [ParamSpec] {
+        Self::PARAMS
+    }
+    fn get(&self, key: &str) -> Option<ParamValue> {
+        Some(match key {
+            "leaf" => ParamValue::count(self.max_leaf_prims),
+            "bins" => ParamValue::count(self.bins),
+            "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
+            "intersection-cost" => ParamValue::Float(self.intersection_cost.into()),
+            "leaf-block" => ParamValue::count(self.leaf_block),
+            _ => return None,
+        })
+    }
+    fn put(&mut self, key: &str, v: ParamValue) {
         match key {
-            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
-            "bins" => self.bins = parse_value(key, value)?,
-            "traversal-cost" => self.traversal_cost = parse_value(key, value)?,
-            "intersection-cost" => self.intersection_cost = parse_value(key, value)?,
-            "leaf-block" => self.leaf_block = parse_value(key, value)?,
-            _ => return Err(unknown_key("bvh", key, Self::KEYS)),
+            "leaf" => self.max_leaf_prims = v.as_usize(),
+            "bins" => self.bins = v.as_usize(),
+            "traversal-cost" => self.traversal_cost = v.as_f32(),
+            "intersection-cost" => self.intersection_cost = v.as_f32(),
+            "leaf-block" => self.leaf_block = v.as_usize(),
+            _ => {}
         }
-        Ok(())
     }
 }
 
 /// Parameters of the median build: its only knob is the leaf size (no costs, no bins).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MedianParams {
-    /// Most primitives in a leaf (clamped to `1..=LEAF_HARD_MAX`).
+    /// Most primitives in a leaf. Valid: `1..=64` (`LEAF_HARD_MAX`); the builder clamps values set
+    /// directly.
     pub max_leaf_prims: usize,
 }
 
@@ -183,14 +222,23 @@ impl Default for MedianParams {
     }
 }
 
-impl Params for MedianParams {
-    const KEYS: &'static [(&'static str, &'static str)] = &[("leaf", "most primitives in a leaf (1-64)")];
-    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
-        match key {
-            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
-            _ => return Err(unknown_key("bvh-median", key, Self::KEYS)),
+impl MedianParams {
+    /// The parameters by key, with their ranges.
+    pub const PARAMS: &'static [ParamSpec] =
+        &[ParamSpec { key: "leaf", about: "most primitives in a leaf", range: LEAF_RANGE }];
+}
+
+impl ParamSet for MedianParams {
+    fn specs(&self) -> &'static [ParamSpec] {
+        Self::PARAMS
+    }
+    fn get(&self, key: &str) -> Option<ParamValue> {
+        (key == "leaf").then_some(ParamValue::count(self.max_leaf_prims))
+    }
+    fn put(&mut self, key: &str, v: ParamValue) {
+        if key == "leaf" {
+            self.max_leaf_prims = v.as_usize();
         }
-        Ok(())
     }
 }
 

@@ -36,8 +36,8 @@ mod tests;
 
 use std::time::{Duration, Instant};
 
-use super::params::{parse_value, unknown_key};
-use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
+use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
+use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray};
 
 /// Hard limit on the depth of any leaf, whatever the parameters; sizes the traversal stack.
@@ -48,7 +48,7 @@ const LEAF: u32 = 3;
 
 /// One node of the flat array: pbrt's `KdAccelNode`, 8 bytes.
 ///
-/// `flags`' low two bits are the split axis (0, 1, 2) or [`LEAF`]; the upper 30 bits are the above
+/// `flags`' low two bits are the split axis (0, 1, 2) or `LEAF` (3); the upper 30 bits are the above
 /// child's index (inner node) or the primitive count (leaf). `data` is the split position's bits (inner
 /// node), the primitive itself (leaf of one) or the offset of the first reference (larger leaf).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -122,14 +122,15 @@ impl Node {
 /// Build knobs of the kd-tree (costs in the units of Wald and Havran's SAH).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KdTreeParams {
-    /// Cost of one traversal step (`K_T`).
+    /// Cost of one traversal step (`K_T`). Valid: finite, `>= 0`.
     pub traversal_cost: f32,
-    /// Cost of one primitive test (`K_I`).
+    /// Cost of one primitive test (`K_I`). Valid: finite, `>= 0`.
     pub intersection_cost: f32,
     /// Fraction of the cost taken off a split that leaves one side empty (Wald and Havran use 0.2:
-    /// factor 0.8), which favours cutting off empty space.
+    /// factor 0.8), which favours cutting off empty space. Valid: `0..=1`.
     pub empty_bonus: f32,
-    /// Deepest level; `None` is pbrt's `8 + 1.3 log2 N`. Clamped to `MAX_DEPTH - 1`.
+    /// Deepest level; `None` is pbrt's `8 + 1.3 log2 N`. Valid: `0..=63` (`MAX_DEPTH - 1`); the
+    /// builder clamps values set directly.
     pub max_depth: Option<usize>,
 }
 
@@ -176,22 +177,53 @@ impl KdTreeParams {
     }
 }
 
-impl Params for KdTreeParams {
-    const KEYS: &'static [(&'static str, &'static str)] = &[
-        ("traversal-cost", "cost of a traversal step (K_T, default 30)"),
-        ("intersection-cost", "cost of a primitive test (K_I, default 20)"),
-        ("empty-bonus", "share of the cost taken off splits with an empty side (0-1, default 0.2)"),
-        ("depth", "deepest level (default: 8 + 1.3 log2 N, at most 63)"),
+impl KdTreeParams {
+    /// The parameters by key, with their ranges.
+    pub const PARAMS: &'static [ParamSpec] = &[
+        ParamSpec {
+            key: "traversal-cost",
+            about: "cost of a traversal step (K_T)",
+            range: ParamRange::Float { min: 0.0, max: None },
+        },
+        ParamSpec {
+            key: "intersection-cost",
+            about: "cost of a primitive test (K_I)",
+            range: ParamRange::Float { min: 0.0, max: None },
+        },
+        ParamSpec {
+            key: "empty-bonus",
+            about: "share of the cost taken off splits with an empty side",
+            range: ParamRange::Float { min: 0.0, max: Some(1.0) },
+        },
+        ParamSpec {
+            key: "depth",
+            about: "deepest level (auto: 8 + 1.3 log2 N)",
+            range: ParamRange::IntOrAuto { min: 0, max: MAX_DEPTH as i64 - 1 },
+        },
     ];
-    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
+}
+
+impl ParamSet for KdTreeParams {
+    fn specs(&self) -> &'static [ParamSpec] {
+        Self::PARAMS
+    }
+    fn get(&self, key: &str) -> Option<ParamValue> {
+        Some(match key {
+            "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
+            "intersection-cost" => ParamValue::Float(self.intersection_cost.into()),
+            "empty-bonus" => ParamValue::Float(self.empty_bonus.into()),
+            "depth" => self.max_depth.map_or(ParamValue::Auto, ParamValue::count),
+            _ => return None,
+        })
+    }
+    fn put(&mut self, key: &str, v: ParamValue) {
         match key {
-            "traversal-cost" => self.traversal_cost = parse_value(key, value)?,
-            "intersection-cost" => self.intersection_cost = parse_value(key, value)?,
-            "empty-bonus" => self.empty_bonus = parse_value(key, value)?,
-            "depth" => self.max_depth = Some(parse_value(key, value)?),
-            _ => return Err(unknown_key("kdtree", key, Self::KEYS)),
+            "traversal-cost" => self.traversal_cost = v.as_f32(),
+            "intersection-cost" => self.intersection_cost = v.as_f32(),
+            "empty-bonus" => self.empty_bonus = v.as_f32(),
+            "depth" => self.max_depth = (v != ParamValue::Auto).then(|| v.as_usize()),
+            _ => {}
         }
-        Ok(())
     }
 }
 

@@ -2,7 +2,7 @@
 //! force on many rays is the job of `tests/accel_conformance.rs`.
 
 use super::*;
-use crate::accel::{AccelKind, AccelSpec, BruteForce};
+use crate::accel::{AccelConfig, AccelKind, BruteForce};
 use crate::geometry::TriangleMesh;
 use crate::math::Vec3;
 
@@ -250,13 +250,15 @@ fn kdtree_boxes_at_depth_tile_the_root() {
 
 #[test]
 fn kdtree_params_parse_and_depth_limit_holds() {
-    let spec = AccelSpec::new(AccelKind::KdTree)
-        .with_params(["traversal-cost=10", "intersection-cost=30", "empty-bonus=0.5", "depth=3"])
+    let config = AccelConfig::from(AccelKind::KdTree)
+        .with_pairs(["traversal-cost=10", "intersection-cost=30", "empty-bonus=0.5", "depth=3"])
         .unwrap();
-    let p: KdTreeParams = spec.parse().unwrap();
+    let AccelConfig::KdTree(p) = config.clone() else { panic!("{config:?}") };
     assert_eq!(p, KdTreeParams { traversal_cost: 10.0, intersection_cost: 30.0, empty_bonus: 0.5, max_depth: Some(3) });
-    let bad = AccelSpec::new(AccelKind::KdTree).with_params(["bins=3"]).unwrap();
-    assert!(bad.parse::<KdTreeParams>().unwrap_err().contains("no parameter 'bins'"));
+    let bad = AccelConfig::from(AccelKind::KdTree).with_pairs(["bins=3"]).unwrap_err();
+    assert!(bad.to_string().contains("no parameter 'bins'"));
+    let auto = AccelConfig::from(AccelKind::KdTree).with_pairs(["depth=3", "depth=auto"]).unwrap();
+    assert_eq!(auto, AccelConfig::from(AccelKind::KdTree), "depth=auto is the default, pbrt's formula");
     let mesh = soup(1_000, 19);
     let tree = KdTree::build(&mesh, &p);
     assert!(Accel::<TriangleMesh>::stats(&tree).max_depth <= 3);

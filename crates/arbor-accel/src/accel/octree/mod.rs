@@ -31,8 +31,8 @@ mod validate;
 
 use std::time::{Duration, Instant};
 
-use super::params::{parse_value, unknown_key};
-use super::{Accel, AccelStats, Hit, Params, Primitives, TraversalCounts};
+use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
+use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
 /// Deepest level any parameters can ask for (cells 1/65536 of the root): sizes the traversal stack.
@@ -108,12 +108,14 @@ fn is_live(b: &Aabb) -> bool {
 /// Build knobs of the octree.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OctreeParams {
-    /// A cell with at most this many references is a leaf. Clamped to at least 1.
+    /// A cell with at most this many references is a leaf. Valid: `>= 1`; the builder clamps values set
+    /// directly.
     pub max_leaf_prims: usize,
-    /// Deepest level (the root is level 0). Clamped to [`MAX_DEPTH`].
+    /// Deepest level (the root is level 0). Valid: `0..=16` ([`MAX_DEPTH`]); the builder clamps values
+    /// set directly.
     pub max_depth: usize,
     /// Cost of visiting a cell relative to a primitive test, for the check that a split pays (it stops
-    /// cells full of large primitives from multiplying references).
+    /// cells full of large primitives from multiplying references). Valid: finite, `>= 0`.
     pub traversal_cost: f32,
 }
 
@@ -147,20 +149,46 @@ impl OctreeParams {
     }
 }
 
-impl Params for OctreeParams {
-    const KEYS: &'static [(&'static str, &'static str)] = &[
-        ("leaf", "a cell with at most this many primitives is a leaf"),
-        ("depth", "deepest level (root 0, at most 16)"),
-        ("traversal-cost", "cost of a cell visit relative to a primitive test"),
+impl OctreeParams {
+    /// The parameters by key, with their ranges.
+    pub const PARAMS: &'static [ParamSpec] = &[
+        ParamSpec {
+            key: "leaf",
+            about: "a cell with at most this many primitives is a leaf",
+            range: ParamRange::Int { min: 1, max: None },
+        },
+        ParamSpec {
+            key: "depth",
+            about: "deepest level (the root is level 0)",
+            range: ParamRange::Int { min: 0, max: Some(MAX_DEPTH as i64) },
+        },
+        ParamSpec {
+            key: "traversal-cost",
+            about: "cost of a cell visit relative to a primitive test",
+            range: ParamRange::Float { min: 0.0, max: None },
+        },
     ];
-    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
+}
+
+impl ParamSet for OctreeParams {
+    fn specs(&self) -> &'static [ParamSpec] {
+        Self::PARAMS
+    }
+    fn get(&self, key: &str) -> Option<ParamValue> {
+        Some(match key {
+            "leaf" => ParamValue::count(self.max_leaf_prims),
+            "depth" => ParamValue::count(self.max_depth),
+            "traversal-cost" => ParamValue::Float(self.traversal_cost.into()),
+            _ => return None,
+        })
+    }
+    fn put(&mut self, key: &str, v: ParamValue) {
         match key {
-            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
-            "depth" => self.max_depth = parse_value(key, value)?,
-            "traversal-cost" => self.traversal_cost = parse_value(key, value)?,
-            _ => return Err(unknown_key("octree", key, Self::KEYS)),
+            "leaf" => self.max_leaf_prims = v.as_usize(),
+            "depth" => self.max_depth = v.as_usize(),
+            "traversal-cost" => self.traversal_cost = v.as_f32(),
+            _ => {}
         }
-        Ok(())
     }
 }
 

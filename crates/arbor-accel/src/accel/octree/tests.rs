@@ -2,7 +2,7 @@
 //! many rays is the job of `tests/accel_conformance.rs`.
 
 use super::*;
-use crate::accel::{build_with, AccelKind, AccelSpec, BruteForce};
+use crate::accel::{AccelConfig, AccelKind, BruteForce};
 use crate::geometry::TriangleMesh;
 
 use crate::test_rng::Rng;
@@ -121,19 +121,22 @@ fn octree_leaves_out_non_finite_primitives() {
 
 #[test]
 fn octree_params_parse_clamp_and_presets_differ() {
-    let spec = AccelSpec::new(AccelKind::Octree).with_params(["leaf=3", "depth=99", "traversal-cost=2"]).unwrap();
-    let p: OctreeParams = spec.parse().unwrap();
-    assert_eq!((p.max_leaf_prims, p.max_depth, p.traversal_cost), (3, 99, 2.0));
-    assert_eq!(p.sanitized().max_depth, MAX_DEPTH);
-    let bad = AccelSpec::new(AccelKind::Octree).with_params(["bins=3"]).unwrap();
-    assert!(bad.parse::<OctreeParams>().unwrap_err().contains("no parameter 'bins'"));
+    let config = AccelConfig::from(AccelKind::Octree).with_pairs(["leaf=3", "depth=16", "traversal-cost=2"]).unwrap();
+    let AccelConfig::Octree(p) = config.clone() else { panic!("{config:?}") };
+    assert_eq!((p.max_leaf_prims, p.max_depth, p.traversal_cost), (3, 16, 2.0));
+    let too_deep = AccelConfig::from(AccelKind::Octree).with_pairs(["depth=99"]).unwrap_err();
+    assert_eq!(too_deep.to_string(), "parameter 'depth': 99 is outside its range 0..=16");
+    // Written directly, past the configuration's checks, the builder still clamps.
+    assert_eq!(OctreeParams { max_depth: 99, ..p }.sanitized().max_depth, MAX_DEPTH);
+    let bad = AccelConfig::from(AccelKind::Octree).with_pairs(["bins=3"]).unwrap_err();
+    assert!(bad.to_string().contains("no parameter 'bins'"));
     let mesh = soup(3000, 0.3, 5);
     let shallow = Accel::<TriangleMesh>::stats(&Octree::build(&mesh, &OctreeParams::fast_build()));
     let deep = Accel::<TriangleMesh>::stats(&Octree::build(&mesh, &OctreeParams::quality()));
     assert!(shallow.nodes < deep.nodes && shallow.max_depth <= 8, "{shallow:?} {deep:?}");
     let one = Octree::build(&mesh, &OctreeParams { max_depth: 1, ..Default::default() });
     assert_eq!(Accel::<TriangleMesh>::stats(&one).max_depth, 1);
-    assert!(build_with(&spec, &mesh).is_ok());
+    assert!(config.build_accel(&mesh).is_ok());
 }
 
 #[test]

@@ -26,7 +26,7 @@ mod tests;
 
 use super::build::{finish, split_live};
 use super::{Node, LEAF_HARD_MAX};
-use crate::accel::params::{parse_value, unknown_key, Params};
+use crate::accel::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
 use crate::accel::Primitives;
 use crate::math::Aabb;
 
@@ -63,13 +63,13 @@ pub struct BottomUpParams {
     /// one, which builds chains).
     pub cost: MergeCost,
     /// PLOC's search radius: each cluster looks this many positions either way along the Morton order.
-    /// Clamped to `1..=256`.
+    /// Valid: `1..=256`; the builder clamps values set directly.
     pub radius: usize,
     /// [`BottomUpMethod::Auto`] uses the greedy method up to this many primitives.
     pub greedy_max: usize,
     /// Subtrees of at most this many primitives become one leaf when the SAH cost of the leaf (with
     /// [`super::BvhParams`]' default costs) is not above the subtree's; 1 keeps one primitive per leaf.
-    /// Clamped to `1..=LEAF_HARD_MAX`.
+    /// Valid: `1..=64` (`LEAF_HARD_MAX`); the builder clamps values set directly.
     pub max_leaf_prims: usize,
 }
 
@@ -105,39 +105,72 @@ impl BottomUpParams {
     }
 }
 
-impl Params for BottomUpParams {
-    const KEYS: &'static [(&'static str, &'static str)] = &[
-        ("method", "auto, greedy or ploc (auto: greedy up to greedy-max primitives)"),
-        ("cost", "greedy merge cost: distance, volume or area"),
-        ("radius", "PLOC search radius along the Morton order (1-256)"),
-        ("greedy-max", "most primitives for which auto uses the greedy method"),
-        ("leaf", "most primitives a collapsed leaf may hold (1-64; 1 = no collapsing)"),
+impl BottomUpParams {
+    /// The parameters by key, with their ranges.
+    pub const PARAMS: &'static [ParamSpec] = &[
+        ParamSpec {
+            key: "method",
+            about: "agglomerative method (auto: greedy up to greedy-max primitives, PLOC above)",
+            range: ParamRange::Choice(&["auto", "greedy", "ploc"]),
+        },
+        ParamSpec {
+            key: "cost",
+            about: "greedy merge cost",
+            range: ParamRange::Choice(&["distance", "volume", "area"]),
+        },
+        ParamSpec {
+            key: "radius",
+            about: "PLOC search radius along the Morton order",
+            range: ParamRange::Int { min: 1, max: Some(256) },
+        },
+        ParamSpec {
+            key: "greedy-max",
+            about: "most primitives for which auto uses the greedy method",
+            range: ParamRange::Int { min: 0, max: None },
+        },
+        ParamSpec {
+            key: "leaf",
+            about: "most primitives a collapsed leaf may hold (1 = no collapsing)",
+            range: ParamRange::Int { min: 1, max: Some(LEAF_HARD_MAX as i64) },
+        },
     ];
-    fn set(&mut self, key: &str, value: &str) -> Result<(), String> {
-        let bad = || format!("parameter '{key}': cannot read '{value}'");
-        match key {
-            "method" => {
-                self.method = match value.trim() {
-                    "auto" => BottomUpMethod::Auto,
-                    "greedy" => BottomUpMethod::Greedy,
-                    "ploc" => BottomUpMethod::Ploc,
-                    _ => return Err(bad()),
-                }
-            }
-            "cost" => {
-                self.cost = match value.trim() {
-                    "distance" => MergeCost::Distance,
-                    "volume" => MergeCost::Volume,
-                    "area" => MergeCost::Area,
-                    _ => return Err(bad()),
-                }
-            }
-            "radius" => self.radius = parse_value(key, value)?,
-            "greedy-max" => self.greedy_max = parse_value(key, value)?,
-            "leaf" => self.max_leaf_prims = parse_value(key, value)?,
-            _ => return Err(unknown_key("bvh-bottom-up", key, Self::KEYS)),
+}
+
+impl ParamSet for BottomUpParams {
+    fn specs(&self) -> &'static [ParamSpec] {
+        Self::PARAMS
+    }
+    fn get(&self, key: &str) -> Option<ParamValue> {
+        Some(match key {
+            "method" => ParamValue::Word(match self.method {
+                BottomUpMethod::Auto => "auto",
+                BottomUpMethod::Greedy => "greedy",
+                BottomUpMethod::Ploc => "ploc",
+            }),
+            "cost" => ParamValue::Word(match self.cost {
+                MergeCost::Distance => "distance",
+                MergeCost::Volume => "volume",
+                MergeCost::Area => "area",
+            }),
+            "radius" => ParamValue::count(self.radius),
+            "greedy-max" => ParamValue::count(self.greedy_max),
+            "leaf" => ParamValue::count(self.max_leaf_prims),
+            _ => return None,
+        })
+    }
+    fn put(&mut self, key: &str, v: ParamValue) {
+        match (key, v) {
+            ("method", ParamValue::Word("greedy")) => self.method = BottomUpMethod::Greedy,
+            ("method", ParamValue::Word("ploc")) => self.method = BottomUpMethod::Ploc,
+            ("method", _) => self.method = BottomUpMethod::Auto,
+            ("cost", ParamValue::Word("distance")) => self.cost = MergeCost::Distance,
+            ("cost", ParamValue::Word("volume")) => self.cost = MergeCost::Volume,
+            ("cost", _) => self.cost = MergeCost::Area,
+            ("radius", v) => self.radius = v.as_usize(),
+            ("greedy-max", v) => self.greedy_max = v.as_usize(),
+            ("leaf", v) => self.max_leaf_prims = v.as_usize(),
+            _ => {}
         }
-        Ok(())
     }
 }
 

@@ -5,7 +5,7 @@ use super::*;
 use crate::accel::bvh::build::BuildPrim;
 use crate::accel::bvh::tests::{assert_matches_brute, on_threads, rays, sah, soup};
 use crate::accel::bvh::{Bvh, BvhParams, MAX_DEPTH, MAX_SAH_DEPTH};
-use crate::accel::{Accel, AccelKind, AccelSpec};
+use crate::accel::{Accel, AccelConfig, AccelKind};
 use crate::geometry::TriangleMesh;
 use crate::math::{Ray, Vec3};
 
@@ -159,10 +159,10 @@ fn bottom_up_depth_is_bounded_on_chains() {
 
 #[test]
 fn bottom_up_params_parse_keys_and_presets() {
-    let spec = AccelSpec::new(AccelKind::BvhBottomUp)
-        .with_params(["method=ploc", "cost=volume", "radius=4", "greedy-max=10", "leaf=1"])
+    let config = AccelConfig::from(AccelKind::BvhBottomUp)
+        .with_pairs(["method=ploc", "cost=volume", "radius=4", "greedy-max=10", "leaf=1"])
         .unwrap();
-    let p: BottomUpParams = spec.parse().unwrap();
+    let AccelConfig::BvhBottomUp(p) = config.clone() else { panic!("{config:?}") };
     assert_eq!(
         p,
         BottomUpParams {
@@ -173,10 +173,10 @@ fn bottom_up_params_parse_keys_and_presets() {
             max_leaf_prims: 1
         }
     );
-    let bad = AccelSpec::new(AccelKind::BvhBottomUp).with_params(["method=best"]).unwrap();
-    assert_eq!(bad.parse::<BottomUpParams>().unwrap_err(), "parameter 'method': cannot read 'best'");
-    let unknown = AccelSpec::new(AccelKind::BvhBottomUp).with_params(["bins=4"]).unwrap();
-    assert!(unknown.parse::<BottomUpParams>().unwrap_err().contains("no parameter 'bins'"));
+    let bad = AccelConfig::from(AccelKind::BvhBottomUp).with_pairs(["method=best"]).unwrap_err();
+    assert_eq!(bad.to_string(), "parameter 'method': cannot read 'best' (expected auto|greedy|ploc)");
+    let unknown = AccelConfig::from(AccelKind::BvhBottomUp).with_pairs(["bins=4"]).unwrap_err();
+    assert!(unknown.to_string().contains("no parameter 'bins'"));
     let d = BottomUpParams::default();
     assert_eq!((d.method_for(2000), d.method_for(2001)), (BottomUpMethod::Greedy, BottomUpMethod::Ploc));
     assert_eq!(BottomUpParams::fast_build().method_for(10), BottomUpMethod::Ploc);
