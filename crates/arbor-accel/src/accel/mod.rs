@@ -12,6 +12,7 @@
 
 mod brute;
 pub mod bvh;
+mod closest;
 pub mod kdtree;
 mod mesh_prims;
 pub mod octree;

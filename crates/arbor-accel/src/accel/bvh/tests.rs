@@ -336,34 +336,38 @@ fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() 
 /// The node-test kernels this processor runs, scalar first.
 fn kernels() -> Vec<super::wide::Kernel> {
     use super::wide::Kernel;
+    #[allow(unused_mut)] // only x86_64 has more than the scalar kernel
     let mut kernels = vec![Kernel::Scalar];
-    if cfg!(target_arch = "x86_64") {
+    #[cfg(target_arch = "x86_64")]
+    {
         kernels.push(Kernel::Sse);
-    }
-    if Kernel::detect() == Kernel::Avx2 {
-        kernels.push(Kernel::Avx2);
+        kernels.extend(super::wide::Avx2::detect().map(Kernel::Avx2));
     }
     kernels
 }
 
 #[test]
 fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
-    use super::wide::{intersect_with, Kernel};
+    use super::wide::{intersect_with, occluded_with, Kernel};
     let mesh = soup(5000, 29);
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
     let kernels = kernels();
+    let (mut hits, mut occluded) = (0, 0);
     for ray in rays(3000, 8) {
         let run = |k: Kernel| {
             let mut c = TraversalCounts::default();
-            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
-            let hit = unsafe { intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c) };
-            (hit, c.nodes, c.prims)
+            let hit = intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c);
+            let occ = occluded_with(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 4.0);
+            (hit.map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())), occ, c.nodes, c.prims)
         };
         let scalar = run(Kernel::Scalar);
+        hits += scalar.0.is_some() as usize;
+        occluded += scalar.1 as usize;
         for &k in &kernels[1..] {
             assert_eq!(run(k), scalar, "{k:?} {ray:?}");
         }
     }
+    assert!(hits > 300 && occluded > 100, "the rays must hit: {hits} closest hits, {occluded} occluded of 3000");
 }
 
 #[test]
@@ -394,24 +398,10 @@ fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind
         // Every batch size up to 5 (one or both slots, refilled or not), then the rest at once.
         for n in (0..=5).chain([rays.len()]) {
             let mut out = vec![Some(Hit::new(u32::MAX, PrimHit::new(1.0, 0.0, 0.0))); n];
-            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
-            unsafe {
-                intersect_many_with(
-                    k,
-                    &with_copy.wide,
-                    &with_copy.prim_indices,
-                    &mesh,
-                    &rays[..n],
-                    &t_max[..n],
-                    &mut out,
-                )
-            };
+            intersect_many_with(k, &with_copy.wide, &with_copy.prim_indices, &mesh, &rays[..n], &t_max[..n], &mut out);
             assert_eq!(out, single[..n], "{k:?} mesh leaves, batch of {n}");
             let mut out = vec![None; n];
-            // SAFETY: as above.
-            unsafe {
-                intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out)
-            };
+            intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out);
             assert_eq!(out, single[..n], "{k:?} primitive leaves, batch of {n}");
         }
     }
