@@ -59,7 +59,8 @@ impl RayFrame {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
         // The axis of `major_axis`, chosen with branches: scene primitives build a frame per triangle
-        // test, and there the branch-free form cost renders 4%.
+        // test, where the branches predict well and the branch-free form's longer chain shows
+        // (docs/performance.md).
         let ad = ray.dir.abs();
         let kz = if ad.x > ad.y && ad.x > ad.z {
             0

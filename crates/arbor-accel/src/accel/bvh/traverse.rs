@@ -21,8 +21,8 @@
 //!
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 //!
-//! Queries now run on the 8-wide form of the tree (`wide/`), whose exactness rests on this argument;
-//! this binary traversal is kept for tests, which check that both give the same hits.
+//! Queries run on the 8-wide form of the tree (`wide/`), whose exactness rests on this argument; this
+//! binary traversal serves the tests, which check that both give the same hits.
 
 #[cfg(test)]
 use super::{Node, MAX_DEPTH};
