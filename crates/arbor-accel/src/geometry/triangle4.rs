@@ -11,7 +11,8 @@
 //! specially (an edge function exactly zero, which takes the double-precision fallback, and
 //! back-face culling rays) are handed to the scalar function itself.
 //!
-//! On targets other than x86_64 the function is a loop over the lanes calling the scalar test.
+//! On targets other than x86_64, and under Miri (which checks the scalar paths), the function is a loop
+//! over the lanes calling the scalar test.
 
 use super::triangle::{intersect_triangle_in, RayFrame};
 use crate::math::Vec3;
@@ -95,7 +96,7 @@ fn with_scalar(mut out: Tri4Hits, lanes: u32, f: &RayFrame, tris: &Tri4, t_max: 
 /// The hits of the frame's ray with the lanes of `tris` whose bit is set in `lanes` (bits 0..4), in
 /// `(0, t_max)`: lane l hits iff `intersect_triangle_in(f, tris.lane(l)..., t_max)` is Some, with
 /// identical t/b1/b2 bits.
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(any(not(target_arch = "x86_64"), miri))]
 #[inline(always)]
 pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -> Tri4Hits {
     with_scalar(Tri4Hits::NONE, lanes & 0xf, f, tris, t_max)
@@ -107,7 +108,7 @@ pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -
 ///
 /// SSE2 only (the x86_64 baseline) and no `#[target_feature]`, so it inlines into code compiled for
 /// any x86_64 level. Each line below is the scalar line of [`intersect_triangle_in`] it repeats.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(target_arch = "x86_64", not(miri)))]
 #[inline(always)]
 pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -> Tri4Hits {
     use std::arch::x86_64::*;
@@ -245,7 +246,7 @@ pub fn intersect_triangles4(f: &RayFrame, tris: &Tri4, lanes: u32, t_max: f32) -
 }
 
 /// `out` with the lanes in `fallback` replaced by the scalar test's results.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(target_arch = "x86_64", not(miri)))]
 #[inline(always)]
 fn finish(mut out: Tri4Hits, fallback: u32, f: &RayFrame, tris: &Tri4, t_max: f32) -> Tri4Hits {
     if fallback != 0 {

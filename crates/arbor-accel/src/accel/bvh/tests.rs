@@ -26,11 +26,16 @@ pub(super) fn rays(n: usize, seed: u64) -> Vec<Ray> {
     (0..n).map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5)).collect()
 }
 
+/// A hit as bits, to compare hits bit for bit (`-0.0` is not `0.0`).
+pub(super) fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32, u32)> {
+    h.map(|h| (h.prim, h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.sub))
+}
+
 pub(super) fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
     let brute = BruteForce::build(mesh);
     for ray in rays {
         let (a, b) = (bvh.intersect(mesh, ray, f32::INFINITY), brute.intersect(mesh, ray, f32::INFINITY));
-        assert_eq!(a, b, "ray {ray:?}");
+        assert_eq!(bits(a), bits(b), "ray {ray:?}: {a:?}, brute force {b:?}");
         assert_eq!(bvh.occluded(mesh, ray, 5.0), brute.occluded(mesh, ray, 5.0));
     }
 }
@@ -454,4 +459,128 @@ fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_f
     assert!(seen.iter().all(|&n| n == 1), "every triangle in exactly one block lane");
     let binary_leaves = bvh.nodes.iter().filter(|n| n.is_leaf()).count();
     assert!(leaf_lanes > binary_leaves, "leaves of two blocks split over free lanes: {leaf_lanes} vs {binary_leaves}");
+}
+
+/// The scalar paths of every query, small enough for Miri (`.ci/miri` runs exactly the tests whose name
+/// holds `scalar_path`): the wide traversal with the scalar node test (closest hit, batch, any hit; mesh
+/// and primitive leaves), the binary traversal, and every structure through the factory, all against
+/// brute force bit for bit. Under Miri the kernel is the scalar one (`Kernel::detect`) and so is the
+/// four-triangle test; the SIMD kernels are compared with it by the native tests above.
+mod scalar_path {
+    use super::*;
+    use crate::accel::bvh::wide::{intersect_many_with, intersect_with, occluded_with, Kernel};
+
+    /// Enough triangles for a wide tree of two levels (leaves of up to 8, 8 children per node).
+    const TRIS: usize = if cfg!(miri) { 150 } else { 1500 };
+    const RAYS: usize = if cfg!(miri) { 40 } else { 2000 };
+
+    /// Rays from around the soup aimed at its triangles' centres, so most of them hit something.
+    fn aimed_rays(mesh: &TriangleMesh, n: usize, seed: u64) -> Vec<Ray> {
+        let mut rng = Rng(seed);
+        (0..n)
+            .map(|_| {
+                let origin = rng.vec3() * 14.0 - 2.0;
+                let [a, b, c] = mesh.triangle((rng.f32() * mesh.len() as f32) as usize % mesh.len());
+                Ray::new(origin, (a + b + c) / 3.0 - origin)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bvh_scalar_path_matches_brute_force_in_every_query_and_leaf_kind() {
+        let mesh = soup(TRIS, 61);
+        let opaque = Opaque(&mesh);
+        let brute = BruteForce::build(&mesh);
+        let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+        let without = Bvh::build_sah(&opaque, &BvhParams::default());
+        assert!(with_copy.wide.nodes().len() > 1, "a tree of more than one wide node");
+        let rays = aimed_rays(&mesh, RAYS, 13);
+        let t_max: Vec<f32> = (0..RAYS).map(|i| if i % 4 == 0 { 3.0 } else { 30.0 }).collect();
+        let want: Vec<_> = rays.iter().zip(&t_max).map(|(r, &t)| brute.intersect(&mesh, r, t)).collect();
+        let hits = want.iter().filter(|h| h.is_some()).count();
+        assert!(2 * hits >= RAYS, "the rays must hit: {hits} of {RAYS}");
+        for (k, (ray, &t)) in rays.iter().zip(&t_max).enumerate() {
+            let mut c = TraversalCounts::default();
+            let got = intersect_with::<_, true>(
+                Kernel::Scalar,
+                &with_copy.wide,
+                &with_copy.prim_indices,
+                &mesh,
+                ray,
+                t,
+                &mut c,
+            );
+            assert_eq!(bits(got), bits(want[k]), "mesh leaves {ray:?}");
+            let got = intersect_with::<_, false>(
+                Kernel::Scalar,
+                &without.wide,
+                &without.prim_indices,
+                &opaque,
+                ray,
+                t,
+                &mut c,
+            );
+            assert_eq!(bits(got), bits(want[k]), "primitive leaves {ray:?}");
+            let binary =
+                traverse::intersect::<_, false>(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t, &mut c);
+            assert_eq!(bits(binary), bits(want[k]), "binary traversal {ray:?}");
+            let occluded = brute.occluded(&mesh, ray, t);
+            assert_eq!(
+                occluded_with(Kernel::Scalar, &with_copy.wide, &with_copy.prim_indices, &mesh, ray, t),
+                occluded
+            );
+            assert_eq!(occluded_with(Kernel::Scalar, &without.wide, &without.prim_indices, &opaque, ray, t), occluded);
+            assert_eq!(traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t), occluded);
+        }
+        // Batches of 1 and 2 (one slot, both slots) and the rest (slots refilled), both leaf kinds.
+        for n in [1, 2, RAYS] {
+            let mut out = vec![None; n];
+            intersect_many_with(
+                Kernel::Scalar,
+                &with_copy.wide,
+                &with_copy.prim_indices,
+                &mesh,
+                &rays[..n],
+                &t_max[..n],
+                &mut out,
+            );
+            assert_eq!(
+                out.iter().map(|&h| bits(h)).collect::<Vec<_>>(),
+                want[..n].iter().map(|&h| bits(h)).collect::<Vec<_>>()
+            );
+            intersect_many_with(
+                Kernel::Scalar,
+                &without.wide,
+                &without.prim_indices,
+                &opaque,
+                &rays[..n],
+                &t_max[..n],
+                &mut out,
+            );
+            assert_eq!(
+                out.iter().map(|&h| bits(h)).collect::<Vec<_>>(),
+                want[..n].iter().map(|&h| bits(h)).collect::<Vec<_>>()
+            );
+        }
+    }
+
+    /// Natively only: the other builders run parallel iterators, and rayon's work-stealing deques
+    /// (crossbeam-epoch) break Miri's Stacked Borrows rules, which would end the run before our code.
+    #[test]
+    #[cfg_attr(miri, ignore = "rayon's crossbeam-epoch fails Stacked Borrows")]
+    fn accel_scalar_path_every_structure_matches_brute_force() {
+        let mesh = soup(TRIS / 3, 71);
+        let brute = BruteForce::build(&mesh);
+        let rays = aimed_rays(&mesh, RAYS / 2, 17);
+        let hits = rays.iter().filter(|r| brute.intersect(&mesh, r, 30.0).is_some()).count();
+        assert!(2 * hits >= rays.len(), "the rays must hit: {hits} of {}", rays.len());
+        for &kind in AccelKind::ALL {
+            let accel = build(kind, &mesh);
+            for ray in &rays {
+                let (got, want) = (accel.intersect(&mesh, ray, 30.0), brute.intersect(&mesh, ray, 30.0));
+                assert_eq!(bits(got), bits(want), "{kind} {ray:?}");
+                assert_eq!(accel.occluded(&mesh, ray, 3.0), brute.occluded(&mesh, ray, 3.0), "{kind} {ray:?}");
+            }
+        }
+    }
 }

@@ -65,7 +65,9 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         // At most one node per primitive and one per leaf: pages reserved but never written cost
         // nothing, and shrinking in place copies nothing.
         nodes.reserve_exact(2 * live.len() - 1);
-        if rayon::current_num_threads() == 1 {
+        // Under Miri, too: starting rayon's pool there breaks Stacked Borrows in crossbeam-epoch, and
+        // both paths build the same tree.
+        if cfg!(miri) || rayon::current_num_threads() == 1 {
             // No parallelism to gain: the whole tree by the flat writer, straight into its array.
             build_flat(&mut live, 0, boxes, 0, params, &mut Bins::new(), &mut nodes);
         } else {
