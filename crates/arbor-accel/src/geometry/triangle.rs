@@ -145,6 +145,8 @@ pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: 
     }
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
+    // Negated so that a NaN `t` or `t_max` is a miss too.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if !(t < t_max) {
         return None;
     }
