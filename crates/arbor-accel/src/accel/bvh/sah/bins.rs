@@ -20,6 +20,7 @@ pub(super) struct Binner {
 }
 
 impl Binner {
+    #[inline]
     pub(super) fn new(axis: usize, min: f32, max: f32, bins: usize) -> Binner {
         let scale32 = bins as f32 / (max - min);
         Binner {
@@ -81,6 +82,7 @@ pub(super) struct Bins {
 }
 
 impl Bins {
+    #[inline]
     pub(super) fn new() -> Box<Bins> {
         Box::new(Bins { counts: [0; MAX_BINS], boxes: [BoxAcc::EMPTY; MAX_BINS] })
     }
@@ -101,6 +103,9 @@ impl Bins {
 /// The cheapest plane and its SAH cost. Only planes after non-empty bins are candidates: the plane
 /// after an empty bin has the same two sides, hence the same cost, as the one after the last non-empty
 /// bin before it, which comes first and wins the tie.
+///
+/// `#[inline]` so that it may still be inlined into its one caller, `find_split`, in another module.
+#[inline]
 pub(super) fn best_bin(
     prims: &[SahPrim],
     bounds: &BoxAcc,

@@ -87,9 +87,11 @@ impl Boxes {
         self.bounds = self.bounds.add_prim(p);
         self.centroids = self.centroids.add_point(p.centroid());
     }
+    #[inline]
     pub(super) fn union(self, o: Boxes) -> Boxes {
         Boxes { bounds: self.bounds.union(o.bounds), centroids: self.centroids.union(o.centroids) }
     }
+    #[inline]
     pub(super) fn of(prims: &[SahPrim]) -> Boxes {
         let mut b = Boxes::EMPTY;
         for p in prims {
