@@ -462,10 +462,11 @@ fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_f
 }
 
 /// The scalar paths of every query, small enough for Miri (`.ci/miri` runs exactly the tests whose name
-/// holds `scalar_path`): the wide traversal with the scalar node test (closest hit, batch, any hit; mesh
-/// and primitive leaves), the binary traversal, and every structure through the factory, all against
-/// brute force bit for bit. Under Miri the kernel is the scalar one (`Kernel::detect`) and so is the
-/// four-triangle test; the SIMD kernels are compared with it by the native tests above.
+/// holds `scalar_path`): the wide traversal with the scalar node test and with the SSE one (Miri runs
+/// SSE2 intrinsics, so it checks that kernel's raw loads too; not AVX2's) in every query (closest hit,
+/// batch, any hit) and kind of leaf, the binary traversal, and every structure through the factory, all
+/// against brute force bit for bit. Under Miri the four-triangle test is its scalar loop and
+/// `Kernel::detect` gives the scalar kernel; natively, the tests above compare all kernels.
 mod scalar_path {
     use super::*;
     use crate::accel::bvh::wide::{intersect_many_with, intersect_with, occluded_with, Kernel};
@@ -486,8 +487,17 @@ mod scalar_path {
             .collect()
     }
 
+    /// The node-test kernels Miri can run: all but AVX2 (whose intrinsics it does not implement).
+    fn portable_kernels() -> Vec<Kernel> {
+        #[allow(unused_mut)] // only x86_64 has the SSE kernel
+        let mut kernels = vec![Kernel::Scalar];
+        #[cfg(target_arch = "x86_64")]
+        kernels.push(Kernel::Sse);
+        kernels
+    }
+
     #[test]
-    fn bvh_scalar_path_matches_brute_force_in_every_query_and_leaf_kind() {
+    fn bvh_scalar_path_and_sse_kernel_match_brute_force_in_every_query_and_leaf_kind() {
         let mesh = soup(TRIS, 61);
         let opaque = Opaque(&mesh);
         let brute = BruteForce::build(&mesh);
@@ -496,71 +506,39 @@ mod scalar_path {
         assert!(with_copy.wide.nodes().len() > 1, "a tree of more than one wide node");
         let rays = aimed_rays(&mesh, RAYS, 13);
         let t_max: Vec<f32> = (0..RAYS).map(|i| if i % 4 == 0 { 3.0 } else { 30.0 }).collect();
-        let want: Vec<_> = rays.iter().zip(&t_max).map(|(r, &t)| brute.intersect(&mesh, r, t)).collect();
+        let want: Vec<_> = rays.iter().zip(&t_max).map(|(r, &t)| bits(brute.intersect(&mesh, r, t))).collect();
+        let occluded: Vec<bool> = rays.iter().zip(&t_max).map(|(r, &t)| brute.occluded(&mesh, r, t)).collect();
         let hits = want.iter().filter(|h| h.is_some()).count();
         assert!(2 * hits >= RAYS, "the rays must hit: {hits} of {RAYS}");
+        let mut c = TraversalCounts::default();
         for (k, (ray, &t)) in rays.iter().zip(&t_max).enumerate() {
-            let mut c = TraversalCounts::default();
-            let got = intersect_with::<_, true>(
-                Kernel::Scalar,
-                &with_copy.wide,
-                &with_copy.prim_indices,
-                &mesh,
-                ray,
-                t,
-                &mut c,
-            );
-            assert_eq!(bits(got), bits(want[k]), "mesh leaves {ray:?}");
-            let got = intersect_with::<_, false>(
-                Kernel::Scalar,
-                &without.wide,
-                &without.prim_indices,
-                &opaque,
-                ray,
-                t,
-                &mut c,
-            );
-            assert_eq!(bits(got), bits(want[k]), "primitive leaves {ray:?}");
             let binary =
                 traverse::intersect::<_, false>(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t, &mut c);
-            assert_eq!(bits(binary), bits(want[k]), "binary traversal {ray:?}");
-            let occluded = brute.occluded(&mesh, ray, t);
-            assert_eq!(
-                occluded_with(Kernel::Scalar, &with_copy.wide, &with_copy.prim_indices, &mesh, ray, t),
-                occluded
-            );
-            assert_eq!(occluded_with(Kernel::Scalar, &without.wide, &without.prim_indices, &opaque, ray, t), occluded);
-            assert_eq!(traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t), occluded);
+            assert_eq!(bits(binary), want[k], "binary traversal {ray:?}");
+            let binary = traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t);
+            assert_eq!(binary, occluded[k], "binary traversal {ray:?}");
         }
-        // Batches of 1 and 2 (one slot, both slots) and the rest (slots refilled), both leaf kinds.
-        for n in [1, 2, RAYS] {
-            let mut out = vec![None; n];
-            intersect_many_with(
-                Kernel::Scalar,
-                &with_copy.wide,
-                &with_copy.prim_indices,
-                &mesh,
-                &rays[..n],
-                &t_max[..n],
-                &mut out,
-            );
-            assert_eq!(
-                out.iter().map(|&h| bits(h)).collect::<Vec<_>>(),
-                want[..n].iter().map(|&h| bits(h)).collect::<Vec<_>>()
-            );
-            intersect_many_with(
-                Kernel::Scalar,
-                &without.wide,
-                &without.prim_indices,
-                &opaque,
-                &rays[..n],
-                &t_max[..n],
-                &mut out,
-            );
-            assert_eq!(
-                out.iter().map(|&h| bits(h)).collect::<Vec<_>>(),
-                want[..n].iter().map(|&h| bits(h)).collect::<Vec<_>>()
-            );
+        for kernel in portable_kernels() {
+            for (k, (ray, &t)) in rays.iter().zip(&t_max).enumerate() {
+                let (w, i) = (&with_copy.wide, &with_copy.prim_indices);
+                let got = intersect_with::<_, true>(kernel, w, i, &mesh, ray, t, &mut c);
+                assert_eq!(bits(got), want[k], "{kernel:?} mesh leaves {ray:?}");
+                assert_eq!(occluded_with(kernel, w, i, &mesh, ray, t), occluded[k], "{kernel:?} {ray:?}");
+                let (w, i) = (&without.wide, &without.prim_indices);
+                let got = intersect_with::<_, false>(kernel, w, i, &opaque, ray, t, &mut c);
+                assert_eq!(bits(got), want[k], "{kernel:?} primitive leaves {ray:?}");
+                assert_eq!(occluded_with(kernel, w, i, &opaque, ray, t), occluded[k], "{kernel:?} {ray:?}");
+            }
+            // Batches of 1 and 2 (one slot, both slots) and the rest (slots refilled), both leaf kinds.
+            for n in [1, 2, RAYS] {
+                let mut out = vec![None; n];
+                let (w, i) = (&with_copy.wide, &with_copy.prim_indices);
+                intersect_many_with(kernel, w, i, &mesh, &rays[..n], &t_max[..n], &mut out);
+                assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want[..n], "{kernel:?} batch of {n}");
+                let (w, i) = (&without.wide, &without.prim_indices);
+                intersect_many_with(kernel, w, i, &opaque, &rays[..n], &t_max[..n], &mut out);
+                assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want[..n], "{kernel:?} batch of {n}");
+            }
         }
     }
 
