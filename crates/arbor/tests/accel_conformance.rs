@@ -85,7 +85,7 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> Ca
         let mut single = Vec::with_capacity(probes.len());
         for (p, &(hit, occluded)) in probes.iter().zip(&expected).step_by(step) {
             if let Some(h) = hit {
-                let t_above = f32::from_bits(h.t.to_bits() + 1);
+                let t_above = h.t.next_up();
                 let got = (accel.occluded(prims, &p.ray, h.t), accel.occluded(prims, &p.ray, t_above));
                 assert_eq!(
                     got,

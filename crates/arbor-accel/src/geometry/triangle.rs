@@ -282,7 +282,7 @@ mod tests {
             let (p0, p1, p2) = (P0 * s, P1 * s, P2 * (s * 1.3));
             let ray = Ray::new(Vec3::new(0.01, 0.02, 1e-40 * k as f32), Vec3::new(0.0, 0.0, -1.0 - k as f32 * 0.01));
             let hit = intersect_triangle(&ray, p0, p1, p2, f32::INFINITY).expect("hit with t_max infinite");
-            let above = f32::from_bits(hit.t.to_bits() + 1);
+            let above = hit.t.next_up();
             let again = intersect_triangle(&ray, p0, p1, p2, above).map(|h| h.t);
             assert_eq!(again, Some(hit.t), "scale {s}: hit at t {:e}, none below t_max {above:e}", hit.t);
         }

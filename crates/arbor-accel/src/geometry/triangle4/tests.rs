@@ -221,7 +221,7 @@ fn tri4_matches_scalar_bit_for_bit() {
             0 | 1 => f32::INFINITY,
             2 => range(&mut rng, 0.0, 4.0) * scale,
             3 | 4 => probe.map_or(f32::INFINITY, |h| h.t),
-            5 => probe.map_or(1.0, |h| f32::from_bits(h.t.to_bits() + 1)),
+            5 => probe.map_or(1.0, |h| h.t.next_up()),
             6 => probe.map_or(1.0, |h| f32::from_bits(h.t.to_bits() - 1)),
             _ => [0.0, -1.0, f32::NAN, f32::MAX, 1e-45, f32::MIN_POSITIVE, f32::NEG_INFINITY][int(&mut rng, 7)],
         };
@@ -251,7 +251,7 @@ fn tri4_matches_scalar_bit_for_bit() {
                     cov.scaled_hits += (scale != 1.0 || shift != Vec3::ZERO) as u64;
                 }
                 if let (Some(p), Some(w)) = (probe, want) {
-                    if w.t == p.t && t_max == f32::from_bits(p.t.to_bits() + 1) {
+                    if w.t == p.t && t_max == p.t.next_up() {
                         cov.t_max_at_hit_kept += 1;
                     }
                 }
