@@ -722,15 +722,19 @@ fn lattice_point() -> impl Strategy<Value = Vec3> {
     prop::array::uniform3(-12i32..=12).prop_map(|[x, y, z]| Vec3::new(x as f32, y as f32, z as f32) / 4.0)
 }
 
+/// A ray of the lattice family: origin, target and mode (0: +x, 1: -z, 2: at the target, 3: at the
+/// target with `t_max` 1).
+type LatticeRay = (Vec3, Vec3, u8);
+
 /// A small soup on the lattice and rays between lattice points, some along the axes, some short.
-fn lattice_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Vec<(Vec3, Vec3, u8)>)> {
+fn lattice_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Vec<LatticeRay>)> {
     (
         prop::collection::vec(prop::array::uniform3(lattice_point()), 0..48),
         prop::collection::vec((lattice_point(), lattice_point(), 0u8..4), 1..96),
     )
 }
 
-fn lattice_probes(rays: &[(Vec3, Vec3, u8)]) -> Vec<Probe> {
+fn lattice_probes(rays: &[LatticeRay]) -> Vec<Probe> {
     rays.iter()
         .map(|&(o, target, mode)| {
             let dir = match mode {
