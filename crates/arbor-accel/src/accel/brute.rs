@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use super::closest::ClosestHit;
 use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray};
 
@@ -43,30 +44,24 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
-        // Ascending order with a strictly shrinking limit: a later primitive at the same `t` has a higher
-        // index and is rightly refused, so ties go to the lowest index.
-        let mut best: Option<Hit> = None;
-        let mut limit = t_max;
+        let mut best = ClosestHit::new(t_max);
         for i in 0..self.len {
-            if let Some(h) = prims.intersect(i, ray, limit) {
-                limit = h.t;
-                best = Some(Hit::new(i as u32, h));
+            if let Some(h) = prims.intersect(i, ray, best.t_query()) {
+                best.offer(Hit::new(i as u32, h));
             }
         }
-        best
+        best.hit()
     }
 
     fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
         counts.nodes += 1;
-        let mut best: Option<Hit> = None;
-        let mut limit = t_max;
+        let mut best = ClosestHit::new(t_max);
         for i in 0..self.len {
-            if let Some(h) = prims.intersect_counted(i, ray, limit, counts) {
-                limit = h.t;
-                best = Some(Hit::new(i as u32, h));
+            if let Some(h) = prims.intersect_counted(i, ray, best.t_query(), counts) {
+                best.offer(Hit::new(i as u32, h));
             }
         }
-        best
+        best.hit()
     }
 
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {

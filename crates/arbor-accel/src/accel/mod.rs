@@ -15,6 +15,7 @@
 mod brute;
 #[doc(hidden)]
 pub mod bvh;
+mod closest;
 mod config;
 #[doc(hidden)]
 pub mod kdtree;

@@ -50,6 +50,8 @@ impl Sphere {
         let b = -f.dot(d);
         let l = f + (b / dd) * d;
         let disc = dd * (self.radius * self.radius - l.length_squared());
+        // Negated so that a NaN discriminant (a degenerate ray or sphere) is a miss too.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(disc >= 0.0) {
             return None;
         }

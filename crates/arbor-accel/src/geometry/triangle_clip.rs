@@ -130,7 +130,7 @@ impl Polygon {
 fn round_down(x: f64) -> f32 {
     let f = x as f32;
     if f as f64 > x {
-        next_toward(f, f32::NEG_INFINITY)
+        f.next_down()
     } else {
         f
     }
@@ -140,19 +140,10 @@ fn round_down(x: f64) -> f32 {
 fn round_up(x: f64) -> f32 {
     let f = x as f32;
     if (f as f64) < x {
-        next_toward(f, f32::INFINITY)
+        f.next_up()
     } else {
         f
     }
-}
-
-/// The neighbour of finite `f` toward `target` (`f32::next_up`/`next_down` need Rust 1.86).
-fn next_toward(f: f32, target: f32) -> f32 {
-    if f == 0.0 {
-        return if target > 0.0 { f32::from_bits(1) } else { -f32::from_bits(1) };
-    }
-    let up = (target > f) == (f > 0.0);
-    f32::from_bits(if up { f.to_bits() + 1 } else { f.to_bits() - 1 })
 }
 
 #[cfg(test)]
@@ -257,5 +248,19 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn triangle_clip_rounds_outward_to_the_neighbouring_float() {
+        let third = 1.0f64 / 3.0;
+        let (down, up) = (round_down(third), round_up(third));
+        assert!((down as f64) <= third && (up as f64) >= third && up == down.next_up());
+        assert_eq!(round_down(0.5).to_bits(), 0.5f32.to_bits(), "exact values stay");
+        assert_eq!(round_up(0.5).to_bits(), 0.5f32.to_bits());
+        let tiny = f64::MIN_POSITIVE;
+        assert_eq!((round_down(tiny).to_bits(), round_up(tiny).to_bits()), (0, 1), "below the subnormals");
+        assert_eq!((round_down(-tiny).to_bits(), round_up(-tiny)), ((-f32::from_bits(1)).to_bits(), -0.0));
+        assert_eq!(round_down(1e300), f32::MAX, "beyond the range: the largest float below");
+        assert_eq!(round_up(-1e300), f32::MIN);
     }
 }

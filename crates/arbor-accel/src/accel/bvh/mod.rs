@@ -1,7 +1,8 @@
 //! Bounding volume hierarchy: a binary tree of axis-aligned boxes over primitive indices, stored as one
 //! flat array of 32-byte nodes (pbrt's `LinearBVHNode`). Three builders write that array, and share
-//! the traversal (`traverse.rs`) and the checks (`validate.rs`):
-//! - [`Bvh::build_sah`] (`build.rs`): top-down, binned surface area heuristic (Wald 2007, "On fast
+//! the build machinery (`build.rs`), the traversal (`wide/`, checked against the binary `traverse.rs`) and
+//! the checks (`validate.rs`):
+//! - [`Bvh::build_sah`] (`sah/`): top-down, binned surface area heuristic (Wald 2007, "On fast
 //!   construction of SAH-based bounding volume hierarchies"; pbrt-v4's `BVHAggregate`);
 //! - [`Bvh::build_median`] (`median.rs`): top-down, split at the median centroid on the longest axis;
 //! - [`Bvh::build_bottom_up`] (`bottom_up/`): agglomerative, the exact greedy method for small inputs
@@ -28,6 +29,7 @@
 mod bottom_up;
 mod build;
 mod median;
+mod sah;
 mod traverse;
 mod validate;
 mod wide;
@@ -261,7 +263,7 @@ impl Bvh {
         if prims.triangle_mesh().is_none() {
             params.leaf_block = 1;
         }
-        let (nodes, prim_indices, live) = build::build_sah(prims, &params);
+        let (nodes, prim_indices, live) = sah::build_sah(prims, &params);
         Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start)
     }
 

@@ -26,11 +26,16 @@ pub(super) fn rays(n: usize, seed: u64) -> Vec<Ray> {
     (0..n).map(|_| Ray::new(rng.vec3() * 14.0 - 2.0, rng.vec3() - 0.5)).collect()
 }
 
+/// A hit as bits, to compare hits bit for bit (`-0.0` is not `0.0`).
+pub(super) fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32, u32)> {
+    h.map(|h| (h.prim, h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.sub))
+}
+
 pub(super) fn assert_matches_brute(mesh: &TriangleMesh, bvh: &Bvh, rays: &[Ray]) {
     let brute = BruteForce::build(mesh);
     for ray in rays {
         let (a, b) = (bvh.intersect(mesh, ray, f32::INFINITY), brute.intersect(mesh, ray, f32::INFINITY));
-        assert_eq!(a, b, "ray {ray:?}");
+        assert_eq!(bits(a), bits(b), "ray {ray:?}: {a:?}, brute force {b:?}");
         assert_eq!(bvh.occluded(mesh, ray, 5.0), brute.occluded(mesh, ray, 5.0));
     }
 }
@@ -336,34 +341,38 @@ fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() 
 /// The node-test kernels this processor runs, scalar first.
 fn kernels() -> Vec<super::wide::Kernel> {
     use super::wide::Kernel;
+    #[allow(unused_mut)] // only x86_64 has more than the scalar kernel
     let mut kernels = vec![Kernel::Scalar];
-    if cfg!(target_arch = "x86_64") {
+    #[cfg(target_arch = "x86_64")]
+    {
         kernels.push(Kernel::Sse);
-    }
-    if Kernel::detect() == Kernel::Avx2 {
-        kernels.push(Kernel::Avx2);
+        kernels.extend(super::wide::Avx2::detect().map(Kernel::Avx2));
     }
     kernels
 }
 
 #[test]
 fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
-    use super::wide::{intersect_with, Kernel};
+    use super::wide::{intersect_with, occluded_with, Kernel};
     let mesh = soup(5000, 29);
     let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
     let kernels = kernels();
+    let (mut hits, mut occluded) = (0, 0);
     for ray in rays(3000, 8) {
         let run = |k: Kernel| {
             let mut c = TraversalCounts::default();
-            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
-            let hit = unsafe { intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c) };
-            (hit, c.nodes, c.prims)
+            let hit = intersect_with::<_, true>(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 30.0, &mut c);
+            let occ = occluded_with(k, &bvh.wide, &bvh.prim_indices, &mesh, &ray, 4.0);
+            (hit.map(|h| (h.t.to_bits(), h.prim, h.u.to_bits(), h.v.to_bits())), occ, c.nodes, c.prims)
         };
         let scalar = run(Kernel::Scalar);
+        hits += scalar.0.is_some() as usize;
+        occluded += scalar.1 as usize;
         for &k in &kernels[1..] {
             assert_eq!(run(k), scalar, "{k:?} {ray:?}");
         }
     }
+    assert!(hits > 300 && occluded > 100, "the rays must hit: {hits} closest hits, {occluded} occluded of 3000");
 }
 
 #[test]
@@ -394,24 +403,10 @@ fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind
         // Every batch size up to 5 (one or both slots, refilled or not), then the rest at once.
         for n in (0..=5).chain([rays.len()]) {
             let mut out = vec![Some(Hit::new(u32::MAX, PrimHit::new(1.0, 0.0, 0.0))); n];
-            // SAFETY: `kernels` holds only what this processor runs (AVX2 only when detected).
-            unsafe {
-                intersect_many_with(
-                    k,
-                    &with_copy.wide,
-                    &with_copy.prim_indices,
-                    &mesh,
-                    &rays[..n],
-                    &t_max[..n],
-                    &mut out,
-                )
-            };
+            intersect_many_with(k, &with_copy.wide, &with_copy.prim_indices, &mesh, &rays[..n], &t_max[..n], &mut out);
             assert_eq!(out, single[..n], "{k:?} mesh leaves, batch of {n}");
             let mut out = vec![None; n];
-            // SAFETY: as above.
-            unsafe {
-                intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out)
-            };
+            intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out);
             assert_eq!(out, single[..n], "{k:?} primitive leaves, batch of {n}");
         }
     }
@@ -464,4 +459,106 @@ fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_f
     assert!(seen.iter().all(|&n| n == 1), "every triangle in exactly one block lane");
     let binary_leaves = bvh.nodes.iter().filter(|n| n.is_leaf()).count();
     assert!(leaf_lanes > binary_leaves, "leaves of two blocks split over free lanes: {leaf_lanes} vs {binary_leaves}");
+}
+
+/// The scalar paths of every query, small enough for Miri (`.ci/miri` runs exactly the tests whose name
+/// holds `scalar_path`): the wide traversal with the scalar node test and with the SSE one (Miri runs
+/// SSE2 intrinsics, so it checks that kernel's raw loads too; not AVX2's) in every query (closest hit,
+/// batch, any hit) and kind of leaf, the binary traversal, and every structure through the factory, all
+/// against brute force bit for bit. Under Miri the four-triangle test is its scalar loop and
+/// `Kernel::detect` gives the scalar kernel; natively, the tests above compare all kernels.
+mod scalar_path {
+    use super::*;
+    use crate::accel::bvh::wide::{intersect_many_with, intersect_with, occluded_with, Kernel};
+
+    /// Enough triangles for a wide tree of two levels (leaves of up to 8, 8 children per node).
+    const TRIS: usize = if cfg!(miri) { 150 } else { 1500 };
+    const RAYS: usize = if cfg!(miri) { 40 } else { 2000 };
+
+    /// Rays from around the soup aimed at its triangles' centres, so most of them hit something.
+    fn aimed_rays(mesh: &TriangleMesh, n: usize, seed: u64) -> Vec<Ray> {
+        let mut rng = Rng(seed);
+        (0..n)
+            .map(|_| {
+                let origin = rng.vec3() * 14.0 - 2.0;
+                let [a, b, c] = mesh.triangle((rng.f32() * mesh.len() as f32) as usize % mesh.len());
+                Ray::new(origin, (a + b + c) / 3.0 - origin)
+            })
+            .collect()
+    }
+
+    /// The node-test kernels Miri can run: all but AVX2 (whose intrinsics it does not implement).
+    fn portable_kernels() -> Vec<Kernel> {
+        #[allow(unused_mut)] // only x86_64 has the SSE kernel
+        let mut kernels = vec![Kernel::Scalar];
+        #[cfg(target_arch = "x86_64")]
+        kernels.push(Kernel::Sse);
+        kernels
+    }
+
+    #[test]
+    fn bvh_scalar_path_and_sse_kernel_match_brute_force_in_every_query_and_leaf_kind() {
+        let mesh = soup(TRIS, 61);
+        let opaque = Opaque(&mesh);
+        let brute = BruteForce::build(&mesh);
+        let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+        let without = Bvh::build_sah(&opaque, &BvhParams::default());
+        assert!(with_copy.wide.nodes().len() > 1, "a tree of more than one wide node");
+        let rays = aimed_rays(&mesh, RAYS, 13);
+        let t_max: Vec<f32> = (0..RAYS).map(|i| if i % 4 == 0 { 3.0 } else { 30.0 }).collect();
+        let want: Vec<_> = rays.iter().zip(&t_max).map(|(r, &t)| bits(brute.intersect(&mesh, r, t))).collect();
+        let occluded: Vec<bool> = rays.iter().zip(&t_max).map(|(r, &t)| brute.occluded(&mesh, r, t)).collect();
+        let hits = want.iter().filter(|h| h.is_some()).count();
+        assert!(2 * hits >= RAYS, "the rays must hit: {hits} of {RAYS}");
+        let mut c = TraversalCounts::default();
+        for (k, (ray, &t)) in rays.iter().zip(&t_max).enumerate() {
+            let binary =
+                traverse::intersect::<_, false>(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t, &mut c);
+            assert_eq!(bits(binary), want[k], "binary traversal {ray:?}");
+            let binary = traverse::occluded(&with_copy.nodes, &with_copy.prim_indices, &mesh, ray, t);
+            assert_eq!(binary, occluded[k], "binary traversal {ray:?}");
+        }
+        for kernel in portable_kernels() {
+            for (k, (ray, &t)) in rays.iter().zip(&t_max).enumerate() {
+                let (w, i) = (&with_copy.wide, &with_copy.prim_indices);
+                let got = intersect_with::<_, true>(kernel, w, i, &mesh, ray, t, &mut c);
+                assert_eq!(bits(got), want[k], "{kernel:?} mesh leaves {ray:?}");
+                assert_eq!(occluded_with(kernel, w, i, &mesh, ray, t), occluded[k], "{kernel:?} {ray:?}");
+                let (w, i) = (&without.wide, &without.prim_indices);
+                let got = intersect_with::<_, false>(kernel, w, i, &opaque, ray, t, &mut c);
+                assert_eq!(bits(got), want[k], "{kernel:?} primitive leaves {ray:?}");
+                assert_eq!(occluded_with(kernel, w, i, &opaque, ray, t), occluded[k], "{kernel:?} {ray:?}");
+            }
+            // Batches of 1 and 2 (one slot, both slots) and the rest (slots refilled), both leaf kinds.
+            for n in [1, 2, RAYS] {
+                let mut out = vec![None; n];
+                let (w, i) = (&with_copy.wide, &with_copy.prim_indices);
+                intersect_many_with(kernel, w, i, &mesh, &rays[..n], &t_max[..n], &mut out);
+                assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want[..n], "{kernel:?} batch of {n}");
+                let (w, i) = (&without.wide, &without.prim_indices);
+                intersect_many_with(kernel, w, i, &opaque, &rays[..n], &t_max[..n], &mut out);
+                assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want[..n], "{kernel:?} batch of {n}");
+            }
+        }
+    }
+
+    /// Natively only: the other builders run parallel iterators, and rayon's work-stealing deques
+    /// (crossbeam-epoch) break Miri's Stacked Borrows rules, which would end the run before our code.
+    #[test]
+    #[cfg_attr(miri, ignore = "rayon's crossbeam-epoch fails Stacked Borrows")]
+    fn accel_scalar_path_every_structure_matches_brute_force() {
+        let mesh = soup(TRIS / 3, 71);
+        let brute = BruteForce::build(&mesh);
+        let rays = aimed_rays(&mesh, RAYS / 2, 17);
+        let hits = rays.iter().filter(|r| brute.intersect(&mesh, r, 30.0).is_some()).count();
+        assert!(2 * hits >= rays.len(), "the rays must hit: {hits} of {}", rays.len());
+        for &kind in AccelKind::ALL {
+            let accel = build(kind, &mesh);
+            for ray in &rays {
+                let (got, want) = (accel.intersect(&mesh, ray, 30.0), brute.intersect(&mesh, ray, 30.0));
+                assert_eq!(bits(got), bits(want), "{kind} {ray:?}");
+                assert_eq!(accel.occluded(&mesh, ray, 3.0), brute.occluded(&mesh, ray, 3.0), "{kind} {ray:?}");
+            }
+        }
+    }
 }

@@ -5,7 +5,7 @@
 //! Exactness against brute force:
 //! - ties: a node whose entry distance *equals* the best `t` is still visited, and a leaf asks each
 //!   primitive for hits up to the float just above the best `t`, keeping one at the same `t` when its
-//!   index is lower ([`Hit::beats`]);
+//!   index is lower (`ClosestHit`);
 //! - box tests are conservative. The `t` a primitive reports carries its own rounding error, and that
 //!   error is not relative to `t`: the watertight test computes `t` as a barycentric blend of the
 //!   corners' distances along the ray's major axis, so its error scales with the largest of them, which
@@ -21,11 +21,13 @@
 //!
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 //!
-//! Queries now run on the 8-wide form of the tree (`wide/`), whose exactness rests on this argument;
-//! this binary traversal is kept for tests, which check that both give the same hits.
+//! Queries run on the 8-wide form of the tree (`wide/`), whose exactness rests on this argument; this
+//! binary traversal serves the tests, which check that both give the same hits.
 
 #[cfg(test)]
 use super::{Node, MAX_DEPTH};
+#[cfg(test)]
+use crate::accel::closest::ClosestHit;
 #[cfg(test)]
 use crate::accel::{Hit, Primitives, TraversalCounts};
 #[cfg(test)]
@@ -118,10 +120,7 @@ pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
         return None;
     }
     let test = RayBoxTest::new(ray);
-    let mut best: Option<Hit> = None;
-    // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
-    let mut t_far = t_max;
-    let mut t_query = t_max;
+    let mut best = ClosestHit::new(t_max);
     let mut stack = [0u32; MAX_DEPTH];
     let mut sp = 0;
     let mut i = 0usize;
@@ -130,22 +129,17 @@ pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
         if COUNT {
             counts.nodes += 1;
         }
-        if test.hits(node, t_far) {
+        if test.hits(node, best.t_far()) {
             if node.is_leaf() {
                 let first = node.offset as usize;
                 for &prim in &indices[first..first + node.count as usize] {
                     let h = if COUNT {
-                        prims.intersect_counted(prim as usize, ray, t_query, counts)
+                        prims.intersect_counted(prim as usize, ray, best.t_query(), counts)
                     } else {
-                        prims.intersect(prim as usize, ray, t_query)
+                        prims.intersect(prim as usize, ray, best.t_query())
                     };
                     if let Some(h) = h {
-                        let hit = Hit::new(prim, h);
-                        if hit.beats(&best) {
-                            t_far = hit.t;
-                            t_query = next_up(hit.t);
-                            best = Some(hit);
-                        }
+                        best.offer(Hit::new(prim, h));
                     }
                 }
             } else {
@@ -157,7 +151,7 @@ pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
             }
         }
         if sp == 0 {
-            return best;
+            return best.hit();
         }
         sp -= 1;
         i = stack[sp] as usize;
@@ -202,15 +196,5 @@ pub(crate) fn occluded<P: Primitives + ?Sized>(
         }
         sp -= 1;
         i = stack[sp] as usize;
-    }
-}
-
-/// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
-#[inline]
-pub(super) fn next_up(t: f32) -> f32 {
-    if t.is_finite() && t >= 0.0 {
-        f32::from_bits(t.to_bits() + 1)
-    } else {
-        t
     }
 }

@@ -136,10 +136,8 @@ pub struct KdTreeParams {
 
 impl Default for KdTreeParams {
     /// `K_T = 30`, `K_I = 20`, bonus 0.2 and pbrt's automatic depth. Wald and Havran's `K_T = 15`
-    /// ([`KdTreeParams::wald_havran`]) builds trees twice as large (5.3 references per triangle on the
-    /// Stanford bunny against 3.6) that traced slower in one-off single-thread timings on a shared,
-    /// noisy machine: relative to the SAH BVH on the same rays, about 0.75 with these costs, 0.45 to
-    /// 0.6 with theirs and 0.63 with pbrt's.
+    /// ([`KdTreeParams::wald_havran`]) builds trees about twice as large that traced slower
+    /// (docs/performance.md).
     fn default() -> Self {
         KdTreeParams { traversal_cost: 30.0, intersection_cost: 20.0, empty_bonus: 0.2, max_depth: None }
     }

@@ -5,7 +5,7 @@
 //! Closest hit, exactly as brute force returns it: a primitive found in one leaf may be hit beyond that
 //! leaf (it straddles cells), so finding a hit does not end the search. A pushed node is skipped only
 //! when the best `t` lies before its interval by more than a margin, so a hit tying the best `t` there
-//! is still seen and the lowest index wins ([`Hit::beats`]; primitives are asked for hits up to the
+//! is still seen and the lowest index wins ([`ClosestHit`]: primitives are asked for hits up to the
 //! float just above the best `t`).
 //!
 //! Conservative margins. The decisions "the plane is crossed before / after the interval" and "the best
@@ -24,6 +24,7 @@
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 
 use super::{KdTree, MAX_DEPTH};
+use crate::accel::closest::ClosestHit;
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
@@ -127,8 +128,7 @@ pub(super) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
     let clipped = Clipped::new(tree, ray, t_max)?;
-    let mut best: Option<Hit> = None;
-    let mut t_query = t_max;
+    let mut best = ClosestHit::new(t_max);
     let mut stack = [Todo::default(); MAX_DEPTH];
     let mut sp = 0;
     let mut at = clipped.root;
@@ -148,26 +148,22 @@ pub(super) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
         }
         for &prim in node.prims(&tree.refs) {
             let h = if COUNT {
-                prims.intersect_counted(prim as usize, ray, t_query, counts)
+                prims.intersect_counted(prim as usize, ray, best.t_query(), counts)
             } else {
-                prims.intersect(prim as usize, ray, t_query)
+                prims.intersect(prim as usize, ray, best.t_query())
             };
             if let Some(h) = h {
-                let hit = Hit::new(prim, h);
-                if hit.beats(&best) {
-                    t_query = next_up(hit.t);
-                    best = Some(hit);
-                }
+                best.offer(Hit::new(prim, h));
             }
         }
         // Skip pushed nodes that start after the best hit (by more than the margin).
         loop {
             if sp == 0 {
-                return best;
+                return best.hit();
             }
             sp -= 1;
             at = stack[sp];
-            if best.is_none_or(|b| b.t >= at.t_min - clipped.margin) {
+            if best.hit().is_none_or(|b| b.t >= at.t_min - clipped.margin) {
                 break;
             }
         }
@@ -201,15 +197,5 @@ pub(super) fn occluded<P: Primitives + ?Sized>(tree: &KdTree, prims: &P, ray: &R
         }
         sp -= 1;
         at = stack[sp];
-    }
-}
-
-/// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
-#[inline]
-fn next_up(t: f32) -> f32 {
-    if t.is_finite() && t >= 0.0 {
-        f32::from_bits(t.to_bits() + 1)
-    } else {
-        t
     }
 }

@@ -27,6 +27,7 @@
 //! the stack.
 
 use super::{child_box, split_point, Octree, MAX_DEPTH};
+use crate::accel::closest::ClosestHit;
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
@@ -141,15 +142,12 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
     // stays in place until they are all popped.
     let mut expanded = [tree.root; MAX_DEPTH + 1];
     let mut sp = 1;
-    let mut best: Option<Hit> = None;
-    let mut limit = t_max;
-    // Primitives are asked for hits below `t_query`, just above the best `t`, to see ties.
-    let mut t_query = t_max;
+    let mut best = ClosestHit::new(t_max);
     let mut mailbox = Mailbox::default();
     while sp > 0 {
         sp -= 1;
         let p = stack[sp];
-        if p.entry - rc.slack > limit {
+        if p.entry - rc.slack > best.t_far() {
             continue;
         }
         if COUNT {
@@ -164,26 +162,22 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
                 }
                 if ANY {
                     // Shadow rays want any hit: a primitive that is itself a structure may stop early.
-                    if prims.occludes(prim as usize, ray, t_query) {
+                    if prims.occludes(prim as usize, ray, best.t_query()) {
                         return Some(Hit { t: 0.0, prim, u: 0.0, v: 0.0, sub: 0 });
                     }
                     continue;
                 }
                 let h = if COUNT {
-                    prims.intersect_counted(prim as usize, ray, t_query, counts)
+                    prims.intersect_counted(prim as usize, ray, best.t_query(), counts)
                 } else {
-                    prims.intersect(prim as usize, ray, t_query)
+                    prims.intersect(prim as usize, ray, best.t_query())
                 };
-                let Some(h) = h else { continue };
-                let hit = Hit::new(prim, h);
-                if hit.beats(&best) {
-                    limit = hit.t;
-                    t_query = next_up(hit.t);
-                    best = Some(hit);
+                if let Some(h) = h {
+                    best.offer(Hit::new(prim, h));
                 }
             }
-            if best.is_some() && limit < p.exit - 2.0 * rc.slack {
-                return best;
+            if best.hit().is_some() && best.t_far() < p.exit - 2.0 * rc.slack {
+                return best.hit();
             }
             continue;
         }
@@ -201,7 +195,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
         let mut n = 0;
         for (k, &(entry, exit)) in intervals.iter().enumerate() {
             let child = node.offset + k as u32;
-            if nodes[child as usize].count == 0 || !rc.visits(entry, exit, limit) {
+            if nodes[child as usize].count == 0 || !rc.visits(entry, exit, best.t_far()) {
                 continue; // an empty leaf, or not crossed
             }
             let mut j = n;
@@ -215,7 +209,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
         stack[sp..sp + n].copy_from_slice(&crossed[..n]);
         sp += n;
     }
-    best
+    best.hit()
 }
 
 /// The last primitives tested (mailboxing, Arnaldi et al. 1987, here a small ring): a primitive
@@ -243,15 +237,5 @@ impl Mailbox {
         self.next = (self.next + 1) % MAILBOX;
         self.full |= self.next == 0;
         true
-    }
-}
-
-/// The next float above a positive finite `t` (`f32::next_up`, stable only since Rust 1.86).
-#[inline]
-fn next_up(t: f32) -> f32 {
-    if t.is_finite() && t >= 0.0 {
-        f32::from_bits(t.to_bits() + 1)
-    } else {
-        t
     }
 }

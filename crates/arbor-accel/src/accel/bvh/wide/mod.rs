@@ -1,7 +1,7 @@
 //! The 8-wide form of a binary BVH, which is what queries traverse (Wald, Benthin and Boulos 2008,
 //! "Getting rid of packets"; Embree's BVH8): every binary tree, whatever its builder, is collapsed
 //! into nodes of up to eight children whose boxes are stored as structure-of-arrays `f32` lanes, so
-//! one ray is tested against eight boxes at once (`traverse.rs`: AVX2 when the processor has it,
+//! one ray is tested against eight boxes at once (`kernel.rs`: AVX2 when the processor has it,
 //! else two SSE halves). Eight children rather than four: a query visits about half as many nodes, and
 //! node fetches are where incoherent rays spend their time.
 //!
@@ -23,12 +23,31 @@
 //! Cost: 256 bytes per node (about `n / (5 * leaf size)` nodes), 160 bytes per block of up to four
 //! triangles; the collapse is linear in the binary tree's size (plus a sort of each split leaf's few
 //! triangles).
+//!
+//! Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
+//! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
+//! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
+//! (`batch.rs`) and the any-hit query (`any_hit.rs`).
 
-mod traverse;
+mod any_hit;
+mod batch;
+mod closest;
+mod dispatch;
+mod kernel;
+mod leaves;
+mod visit;
 
-pub(super) use traverse::{intersect, intersect_many, occluded};
+pub(super) use any_hit::occluded;
 #[cfg(test)]
-pub(super) use traverse::{intersect_many_with, intersect_with, Kernel};
+pub(super) use any_hit::occluded_with;
+pub(super) use batch::intersect_many;
+#[cfg(test)]
+pub(super) use batch::intersect_many_with;
+pub(super) use closest::intersect;
+#[cfg(test)]
+pub(super) use closest::intersect_with;
+#[cfg(test)]
+pub(super) use kernel::{Avx2, Kernel};
 
 use super::Node;
 use crate::accel::Primitives;
@@ -54,6 +73,13 @@ pub struct Node8 {
 }
 
 const _: () = assert!(std::mem::size_of::<Node8>() == 256);
+
+// SAFETY: `Node8` is `repr(C)` of arrays of `f32` and `u32` only (every bit pattern valid, all zeros
+// included), 256 bytes with no padding (asserted above: 48 floats and 16 words fill it), so it may be
+// viewed as plain bytes or floats (`kernel.rs` reads its boxes as one `[f32; 64]`).
+unsafe impl bytemuck::Zeroable for Node8 {}
+// SAFETY: as for `Zeroable` above; `Node8` is also `Copy` and `'static`.
+unsafe impl bytemuck::Pod for Node8 {}
 
 impl Node8 {
     const EMPTY: Node8 = Node8 {

@@ -1,0 +1,208 @@
+//! Closest-hit queries for a batch of rays on the 8-wide tree, two rays at once: one node visit of
+//! each in turn ([`Walk`]). A node visit is a chain of dependent loads and arithmetic that one ray
+//! cannot overlap with its next visit, which depends on it, but the other ray's visit can fill that
+//! wait. The node visit and the pop are those of the single query (`visit.rs`), so each ray visits the
+//! same nodes and gets the same hit as it would alone. The counted query and the any-hit query stay
+//! one ray at a time.
+
+use super::dispatch::{run_with, trivially_misses, Traversal};
+use super::kernel::{Kernel, Lanes, NodeTest};
+use super::leaves::{LeafRay, Leaves};
+use super::visit::{new_stack, pop, visit, Stack};
+use super::{Node8, Ref, Wide};
+use crate::accel::closest::ClosestHit;
+use crate::accel::{Hit, Primitives, TraversalCounts};
+use crate::math::Ray;
+
+/// Closest-hit queries for a batch of rays, `out[i]` for `rays[i]` in `(0, t_max[i])`: the same hits as
+/// [`super::intersect`] ray by ray.
+pub(in crate::accel::bvh) fn intersect_many<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    intersect_many_with(Kernel::detect(), wide, indices, prims, rays, t_max, out)
+}
+
+/// [`intersect_many`] with the given kernel (tests compare the kernels).
+pub(in crate::accel::bvh) fn intersect_many_with<P: Primitives + ?Sized>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and hits differ in length");
+    run_with(kernel, wide, indices, prims, Batch { rays, t_max, out })
+}
+
+/// The closest-hit queries of a batch.
+struct Batch<'a> {
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    out: &'a mut [Option<Hit>],
+}
+
+impl Traversal for Batch<'_> {
+    type Out = ();
+
+    fn empty(self) {
+        self.out.fill(None);
+    }
+
+    #[inline(always)]
+    fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) {
+        many(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
+    }
+}
+
+/// The interleaved closest-hit traversals of a batch, from `root`: two rays at once, in two named
+/// slots rather than an array, so that both walks' state stays in registers (more rays at once would
+/// not fit them).
+#[inline(always)]
+fn many<L: Leaves, K: NodeTest>(
+    kernel: K,
+    nodes: &[Node8],
+    leaves: &L,
+    root: Ref,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    let mut next = 0;
+    let Some(i) = next_ray(rays, t_max, out, &mut next) else { return };
+    let (mut ia, mut a) = (i, Walk::new(root, &rays[i], t_max[i]));
+    let Some(i) = next_ray(rays, t_max, out, &mut next) else {
+        out[ia] = a.finish(kernel, nodes, leaves);
+        return;
+    };
+    let (mut ib, mut b) = (i, Walk::new(root, &rays[i], t_max[i]));
+    // Both slots busy: step each in turn; a finished one takes the next ray, until none is left.
+    loop {
+        a.step(kernel, nodes, leaves);
+        b.step(kernel, nodes, leaves);
+        if a.done && !refill(&mut a, &mut ia, root, rays, t_max, out, &mut next) {
+            out[ib] = b.finish(kernel, nodes, leaves);
+            return;
+        }
+        if b.done && !refill(&mut b, &mut ib, root, rays, t_max, out, &mut next) {
+            out[ia] = a.finish(kernel, nodes, leaves);
+            return;
+        }
+    }
+}
+
+/// Hands finished walk `w`'s hit to `out[*i]` and starts it on the batch's next ray (its index into
+/// `*i`); false when no ray is left.
+#[inline(always)]
+fn refill<'r>(
+    w: &mut Walk<'r>,
+    i: &mut usize,
+    root: Ref,
+    rays: &'r [Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+    next: &mut usize,
+) -> bool {
+    out[*i] = w.best.hit();
+    let Some(k) = next_ray(rays, t_max, out, next) else { return false };
+    *i = k;
+    w.restart(root, &rays[k], t_max[k]);
+    true
+}
+
+/// The index of the batch's next ray from `*next` on that needs a traversal; the rays skipped on the
+/// way trivially miss and get `None`.
+#[inline(always)]
+fn next_ray(rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>], next: &mut usize) -> Option<usize> {
+    while *next < rays.len() {
+        let i = *next;
+        *next += 1;
+        if !trivially_misses(&rays[i], t_max[i]) {
+            return Some(i);
+        }
+        out[i] = None;
+    }
+    None
+}
+
+/// One ray's closest-hit traversal as a state advanced one step at a time: a node visit, or a leaf and
+/// the pops after it. The single query (`closest.rs`) is the same traversal run to its end in one loop,
+/// which keeps its state in registers.
+struct Walk<'r> {
+    lanes: Lanes,
+    q: LeafRay<'r>,
+    best: ClosestHit,
+    stack: Stack,
+    sp: usize,
+    cur: Ref,
+    done: bool,
+}
+
+impl<'r> Walk<'r> {
+    #[inline(always)]
+    fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
+        let lanes = Lanes::new(ray);
+        let major = lanes.major;
+        Walk {
+            lanes,
+            q: LeafRay::new(ray, major),
+            best: ClosestHit::new(t_max),
+            stack: new_stack(),
+            sp: 0,
+            cur: root,
+            done: false,
+        }
+    }
+
+    /// Starts over with another ray (in place: the stack is not moved).
+    #[inline(always)]
+    fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
+        self.lanes = Lanes::new(ray);
+        self.q = LeafRay::new(ray, self.lanes.major);
+        self.best = ClosestHit::new(t_max);
+        self.sp = 0;
+        self.cur = root;
+        self.done = false;
+    }
+
+    #[inline(always)]
+    fn step<L: Leaves, K: NodeTest>(&mut self, kernel: K, nodes: &[Node8], leaves: &L) {
+        if self.cur.count == 0 {
+            let node = &nodes[self.cur.child as usize];
+            if let Some(next) = visit::<L, K, true>(
+                kernel,
+                nodes,
+                leaves,
+                &self.lanes,
+                node,
+                self.best.t_far(),
+                &mut self.stack,
+                &mut self.sp,
+            ) {
+                self.cur = next;
+                return;
+            }
+        } else {
+            leaves.closest::<false>(self.cur, &mut self.q, &mut self.best, &mut TraversalCounts::default());
+        }
+        match pop(&self.stack, &mut self.sp, self.best.t_far()) {
+            Some(next) => self.cur = next,
+            None => self.done = true,
+        }
+    }
+
+    /// Runs the traversal to its end and returns its hit.
+    #[inline(always)]
+    fn finish<L: Leaves, K: NodeTest>(&mut self, kernel: K, nodes: &[Node8], leaves: &L) -> Option<Hit> {
+        while !self.done {
+            self.step(kernel, nodes, leaves);
+        }
+        self.best.hit()
+    }
+}

@@ -1,0 +1,106 @@
+//! The closest-hit query of one ray on the 8-wide tree: nearest child first, a stack of the others.
+//!
+//! Exactness against brute force follows the binary traversal (`../traverse.rs`), whose argument holds
+//! lane by lane: the node test is the same conservative box test (`kernel.rs`), a node at exactly the
+//! best `t` is still visited and a popped child is skipped only when its box test would fail
+//! (`visit.rs`), and leaves ask for hits up to the float above the best `t` and keep ties by lowest
+//! primitive index (`leaves.rs`).
+
+use super::dispatch::{run_with, trivially_misses, Traversal};
+use super::kernel::{Kernel, Lanes, NodeTest};
+use super::leaves::{LeafRay, Leaves};
+use super::visit::{new_stack, pop, visit};
+use super::{Node8, Ref, Wide};
+use crate::accel::closest::ClosestHit;
+use crate::accel::{Hit, Primitives, TraversalCounts};
+use crate::math::Ray;
+
+/// The closest hit in `(0, t_max)`, ties to the lowest primitive index; with `COUNT`, the wide nodes
+/// visited and primitives tested are added to `counts`.
+#[inline]
+pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    intersect_with::<P, COUNT>(Kernel::detect(), wide, indices, prims, ray, t_max, counts)
+}
+
+/// [`intersect`] with the given kernel (tests compare the kernels).
+#[inline]
+pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    run_with(kernel, wide, indices, prims, Closest::<COUNT> { ray, t_max, counts })
+}
+
+/// The closest-hit query of one ray.
+struct Closest<'a, const COUNT: bool> {
+    ray: &'a Ray,
+    t_max: f32,
+    counts: &'a mut TraversalCounts,
+}
+
+impl<const COUNT: bool> Traversal for Closest<'_, COUNT> {
+    type Out = Option<Hit>;
+
+    fn empty(self) -> Option<Hit> {
+        None
+    }
+
+    #[inline(always)]
+    fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) -> Option<Hit> {
+        if trivially_misses(self.ray, self.t_max) {
+            return None;
+        }
+        query::<L, K, COUNT>(kernel, nodes, leaves, root, self.ray, self.t_max, self.counts)
+    }
+}
+
+/// The closest-hit traversal from `root`.
+#[inline(always)]
+fn query<L: Leaves, K: NodeTest, const COUNT: bool>(
+    kernel: K,
+    nodes: &[Node8],
+    leaves: &L,
+    root: Ref,
+    ray: &Ray,
+    t_max: f32,
+    counts: &mut TraversalCounts,
+) -> Option<Hit> {
+    let lanes = Lanes::new(ray);
+    let mut q = LeafRay::new(ray, lanes.major);
+    let mut best = ClosestHit::new(t_max);
+    let mut stack = new_stack();
+    let mut sp = 0usize;
+    let mut cur = root;
+    loop {
+        if cur.count == 0 {
+            if COUNT {
+                counts.nodes += 1;
+            }
+            let node = &nodes[cur.child as usize];
+            if let Some(next) =
+                visit::<L, K, false>(kernel, nodes, leaves, &lanes, node, best.t_far(), &mut stack, &mut sp)
+            {
+                cur = next;
+                continue;
+            }
+        } else {
+            leaves.closest::<COUNT>(cur, &mut q, &mut best, counts);
+        }
+        match pop(&stack, &mut sp, best.t_far()) {
+            Some(next) => cur = next,
+            None => return best.hit(),
+        }
+    }
+}

@@ -1,0 +1,242 @@
+//! The node test: one ray against a wide node's eight boxes at once, in three kernels that compute the
+//! same per-lane arithmetic (so they visit the same nodes; a unit test compares them).
+//!
+//! Hand-written SIMD (`std::arch`) because this test is the hot core of every query: the eight slab
+//! tests share the ray's broadcast origin and reciprocal direction, and the per-axis choice of the entry
+//! plane is precomputed as load offsets, so a node test is about 20 instructions without branches.
+//! - [`Avx2`]: the eight lanes in one register per row. Its value is the proof that the processor runs
+//!   AVX2: the only constructor, [`Avx2::detect`], asks the processor, and every path into AVX2 code
+//!   takes that value, so no safe function can run AVX2 instructions on a processor without them.
+//! - [`Sse`]: two 4-lane halves (SSE2 is part of the x86_64 baseline, so any value will do).
+//! - [`Scalar`]: a loop over the lanes (elsewhere than x86_64, and under Miri).
+//!
+//! The box test is the conservative test of the binary traversal (`../traverse.rs`), lane by lane:
+//! `near <= far + scale * SLACK` with `scale` the larger slab distance on the ray's major axis; `max`
+//! and `min` take the accumulator as the operand that wins over a NaN, as `f32::max`/`min` do.
+
+use super::{Node8, WIDTH};
+use crate::accel::BOX_SLACK;
+use crate::math::Ray;
+
+/// Proof that this processor runs AVX2; only [`Avx2::detect`] makes one.
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Avx2 {
+    _detected: (),
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx2 {
+    /// The token when the processor runs AVX2, else `None`.
+    #[inline]
+    pub fn detect() -> Option<Avx2> {
+        // Miri does not run the AVX2 kernel: it is left to native tests.
+        (!cfg!(miri) && std::is_x86_feature_detected!("avx2")).then_some(Avx2 { _detected: () })
+    }
+}
+
+/// The two-halves kernel (SSE2, the x86_64 baseline).
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sse;
+
+/// The lane-by-lane kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scalar;
+
+/// The code that tests a node's boxes, as a value: the kernels a query may run on this processor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kernel {
+    /// One 8-lane AVX2 register per axis and side.
+    #[cfg(target_arch = "x86_64")]
+    Avx2(Avx2),
+    /// Two 4-lane SSE halves.
+    #[cfg(target_arch = "x86_64")]
+    Sse,
+    /// A loop over the lanes (used on x86_64 only by tests: the kernel comparison and Miri).
+    #[cfg_attr(all(target_arch = "x86_64", not(test)), allow(dead_code))]
+    Scalar,
+}
+
+impl Kernel {
+    /// The fastest kernel this processor runs (the scalar one under Miri).
+    #[inline]
+    pub fn detect() -> Kernel {
+        #[cfg(all(target_arch = "x86_64", not(miri)))]
+        {
+            match Avx2::detect() {
+                Some(avx2) => Kernel::Avx2(avx2),
+                None => Kernel::Sse,
+            }
+        }
+        #[cfg(any(not(target_arch = "x86_64"), miri))]
+        Kernel::Scalar
+    }
+}
+
+/// What a node test returns: the lanes whose box the ray meets in `[0, t_far]` (bit per lane), their
+/// entry distances and their slacks.
+pub(super) type Tested = (u32, [f32; WIDTH], [f32; WIDTH]);
+
+/// A node-test kernel. Implemented by zero-sized values, so a traversal generic over it is compiled once
+/// per kernel with the test inlined, and carries the value along at no cost.
+pub(super) trait NodeTest: Copy {
+    /// The lanes of `node` that `lanes`' ray meets in `[0, t_far]`.
+    fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested;
+}
+
+/// A ray prepared for eight-box tests: per axis, where the entry and exit planes are in a node (as `f32`
+/// offsets into it), the broadcast origin and reciprocal direction; and the major axis (the
+/// direction's largest component), whose slab distances size the box slack and which the triangle
+/// test's frame shears along. The axes stay in their natural order: the per-query setup is on every
+/// query's critical path, and permuting it there costs more than asking which axis is major per node.
+pub(super) struct Lanes {
+    enter: [usize; 3],
+    exit: [usize; 3],
+    org: [f32; 3],
+    inv: [f32; 3],
+    pub(super) major: usize,
+}
+
+impl Lanes {
+    #[inline(always)]
+    pub(super) fn new(ray: &Ray) -> Self {
+        let inv = ray.inv_dir.to_array();
+        let major = crate::geometry::major_axis(ray.dir);
+        // `min` is at f32 offset 8a, `max` at 24 + 8a (`Node8` is `repr(C)`).
+        let neg = |a: usize| inv[a].is_sign_negative();
+        let w = WIDTH;
+        Lanes {
+            enter: std::array::from_fn(|a| if neg(a) { 3 * w + w * a } else { w * a }),
+            exit: std::array::from_fn(|a| if neg(a) { w * a } else { 3 * w + w * a }),
+            org: ray.origin.to_array(),
+            inv,
+            major,
+        }
+    }
+}
+
+/// The node's floats: boxes first, then the child words reinterpreted (never read as floats).
+#[inline(always)]
+fn float_view(node: &Node8) -> &[f32; 64] {
+    bytemuck::cast_ref(node)
+}
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Avx2 {
+    #[inline(always)]
+    fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+        // SAFETY: `self` exists, so `Avx2::detect` found AVX2 on this processor.
+        unsafe { test_avx2(lanes, node, t_far) }
+    }
+}
+
+/// The eight lanes in one AVX register per row.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn test_avx2(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+    use std::arch::x86_64::*;
+    let base = float_view(node).as_ptr();
+    let mut near_out = [0.0f32; WIDTH];
+    let mut slack_out = [0.0f32; WIDTH];
+    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+    let mut near = _mm256_setzero_ps();
+    let mut far = _mm256_set1_ps(t_far);
+    let mut scale = _mm256_setzero_ps();
+    for a in 0..3 {
+        let o = _mm256_set1_ps(lanes.org[a]);
+        let inv = _mm256_set1_ps(lanes.inv[a]);
+        // SAFETY: `enter` and `exit` are below 48 and multiples of 8 (`Lanes::new`), so each load reads
+        // eight floats of the 64 of `node`, 32-byte aligned as `_mm256_load_ps` requires (`Node8` is
+        // aligned to 64).
+        let (e0, e1) = unsafe { (_mm256_load_ps(base.add(lanes.enter[a])), _mm256_load_ps(base.add(lanes.exit[a]))) };
+        let t0 = _mm256_mul_ps(_mm256_sub_ps(e0, o), inv);
+        let t1 = _mm256_mul_ps(_mm256_sub_ps(e1, o), inv);
+        // The second operand is returned when either is NaN: the accumulator wins, as in `f32::max`.
+        near = _mm256_max_ps(t0, near);
+        far = _mm256_min_ps(t1, far);
+        if a == lanes.major {
+            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), scale);
+            scale = _mm256_max_ps(_mm256_and_ps(t1, abs), scale);
+        }
+    }
+    let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
+    // SAFETY: each store writes eight floats into a local array of eight.
+    unsafe {
+        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
+    }
+    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack))) as u32;
+    (mask, near_out, slack_out)
+}
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Sse {
+    /// The eight lanes as two SSE halves.
+    #[inline(always)]
+    fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+        use std::arch::x86_64::*;
+        let base = float_view(node).as_ptr();
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
+        let mut mask = 0;
+        // SAFETY: SSE and SSE2 are part of the x86_64 baseline; `enter + half` and `exit + half` are
+        // below 52 and multiples of 4 (`Lanes::new`), so each load reads four floats of the 64 of
+        // `node`, 16-byte aligned as `_mm_load_ps` requires (`Node8` is aligned to 64); each store
+        // writes four floats at offset 0 or 4 of a local array of eight.
+        unsafe {
+            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+            for half in [0, 4] {
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_far);
+                let mut scale = _mm_setzero_ps();
+                for a in 0..3 {
+                    let o = _mm_set1_ps(lanes.org[a]);
+                    let inv = _mm_set1_ps(lanes.inv[a]);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(lanes.enter[a] + half)), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(base.add(lanes.exit[a] + half)), o), inv);
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                    if a == lanes.major {
+                        scale = _mm_max_ps(_mm_and_ps(t0, abs), scale);
+                        scale = _mm_max_ps(_mm_and_ps(t1, abs), scale);
+                    }
+                }
+                let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
+                _mm_storeu_ps(near_out.as_mut_ptr().add(half), near);
+                _mm_storeu_ps(slack_out.as_mut_ptr().add(half), slack);
+                mask |= (_mm_movemask_ps(_mm_cmple_ps(near, _mm_add_ps(far, slack))) as u32) << half;
+            }
+        }
+        (mask, near_out, slack_out)
+    }
+}
+
+impl NodeTest for Scalar {
+    /// The same test one lane at a time.
+    #[inline(always)]
+    fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+        let flat = float_view(node);
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
+        let mut mask = 0;
+        for lane in 0..WIDTH {
+            let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
+            for a in 0..3 {
+                let t0 = (flat[lanes.enter[a] + lane] - lanes.org[a]) * lanes.inv[a];
+                let t1 = (flat[lanes.exit[a] + lane] - lanes.org[a]) * lanes.inv[a];
+                near = near.max(t0);
+                far = far.min(t1);
+                if a == lanes.major {
+                    scale = scale.max(t0.abs()).max(t1.abs());
+                }
+            }
+            let slack = scale * BOX_SLACK;
+            near_out[lane] = near;
+            slack_out[lane] = slack;
+            mask |= ((near <= far + slack) as u32) << lane;
+        }
+        (mask, near_out, slack_out)
+    }
+}
