@@ -11,13 +11,13 @@ macro_rules! say {
 }
 
 mod bench;
-mod bench_rays;
 mod diff;
 mod info;
 mod merge;
 mod progress;
 mod render;
 mod slice;
+mod threads;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -75,17 +75,6 @@ pub fn say_line(args: std::fmt::Arguments) {
             std::process::exit(0);
         }
     }
-}
-
-/// Which threads to use: `--threads N`, or all cores.
-pub fn set_threads(threads: Option<usize>) -> Result<(), Failure> {
-    if let Some(n) = threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build_global()
-            .map_err(|e| arbor::Error::Invalid(format!("cannot start {n} threads: {e}")))?;
-    }
-    Ok(())
 }
 
 /// The scene argument as a display name.

@@ -48,9 +48,8 @@ pub struct RenderArgs {
     /// Samples per pixel, overriding the scene's NumSamples.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub spp: Option<u32>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: crate::threads::ThreadsArg,
     /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
     /// (px nx py ny pz nz).
     #[arg(long)]
@@ -164,7 +163,7 @@ pub fn limits(no_limits: bool) -> SceneLimits {
 /// Runs `arbor render`.
 pub fn run(args: RenderArgs) -> Result<(), Failure> {
     let signals = Signals::install()?;
-    crate::set_threads(args.threads)?;
+    args.threads.apply()?;
     let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
