@@ -28,6 +28,7 @@ use self::generic::{read_element, Ascii};
 use self::header::{check_sizes, parse_header, Element, Format, Header, Kind, Property, Ty};
 use crate::geometry::TriangleMesh;
 use crate::math::{Vec2, Vec3};
+use crate::mesh_io::vec_for;
 use crate::{Error, Location, Result};
 
 /// Parses a PLY file already in memory; `path` is only used in error messages.
@@ -37,10 +38,10 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let (roles, nv) = plan_roles(&header, path)?;
     let faces: u64 = header.elements.iter().filter(|e| e.name == "face").map(|e| e.count).sum();
     let mut out = Out {
-        positions: Vec::with_capacity(nv as usize),
+        positions: vec_for(nv, "vertices", path)?,
         normals: Vec::new(),
         uvs: Vec::new(),
-        indices: Vec::with_capacity(faces as usize),
+        indices: vec_for(faces, "faces", path)?,
     };
     let plan = roles.iter().find_map(|r| match r {
         Role::Vertex(p) => Some(p),
@@ -48,10 +49,10 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     });
     let (has_normals, has_uvs) = plan.map_or((false, false), |p| (p.normals, p.uvs));
     if has_normals {
-        out.normals.reserve(nv as usize);
+        out.normals = vec_for(nv, "vertex normals", path)?;
     }
     if has_uvs {
-        out.uvs.reserve(nv as usize);
+        out.uvs = vec_for(nv, "texture coordinates", path)?;
     }
     match header.format {
         Format::Ascii => {
