@@ -2,7 +2,8 @@
 //! acceleration structures, compare images.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
-//! 4 I/O failure, 130 and 143 when `render` was stopped by SIGINT or SIGTERM (no image written).
+//! 4 I/O failure or not enough memory, 130 and 143 when stopped by SIGINT or SIGTERM (at any stage;
+//! no image written).
 
 /// Prints a line to standard output. A closed pipe (`arbor info | head -1`) ends the program quietly
 /// instead of panicking, as command-line tools do.
@@ -13,11 +14,15 @@ macro_rules! say {
 mod bench;
 mod diff;
 mod info;
+mod memory;
 mod merge;
+mod outputs;
 mod progress;
 mod render;
+mod signals;
 mod slice;
 mod threads;
+mod warnings;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,6 +63,8 @@ pub enum Failure {
     Arbor(arbor::Error),
     /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
     Interrupted(u8),
+    /// A buffer could not be allocated (exit 4, like other failures of the machine rather than the input).
+    OutOfMemory(String),
 }
 
 impl From<arbor::Error> for Failure {
@@ -84,13 +91,13 @@ pub fn shown(path: &Option<PathBuf>) -> String {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Render(args) => render::run(args),
+    let result = signals::Signals::install().and_then(|signals| match cli.command {
+        Command::Render(args) => render::run(args, &signals),
         Command::Info(args) => info::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
-        Command::Merge(args) => merge::run(args),
-    };
+        Command::Merge(args) => merge::run(args, &signals),
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::TooDifferent) => ExitCode::from(1),
@@ -99,8 +106,12 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
         Err(Failure::Interrupted(code)) => {
-            eprintln!("interrupted: an image whose render was stopped is not written");
+            eprintln!("{}", signals::MESSAGE);
             ExitCode::from(code)
+        }
+        Err(Failure::OutOfMemory(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(4)
         }
         Err(Failure::Arbor(e)) => {
             eprintln!("error: {e}");

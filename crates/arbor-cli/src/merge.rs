@@ -14,7 +14,7 @@ pub struct MergeArgs {
     /// Partial EXR files written by `arbor render --tile/--sample-offset/--sample-count` (any order).
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
-    /// The merged image; the extension picks the format (.png, .ppm, .exr).
+    /// The merged image; the extension picks the format (.png, .ppm, .exr, .jpg, .jpeg).
     #[arg(short = 'o', long = "out", value_name = "IMAGE")]
     pub out: PathBuf,
     /// No summary line (`Saved: IMAGE` stays).
@@ -23,7 +23,7 @@ pub struct MergeArgs {
 }
 
 /// Runs `arbor merge`.
-pub fn run(args: MergeArgs) -> Result<(), Failure> {
+pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Failure> {
     let start = std::time::Instant::now();
     let parts = args
         .parts
@@ -31,7 +31,9 @@ pub fn run(args: MergeArgs) -> Result<(), Failure> {
         .map(|p| arbor::farm::read_partial(p).map(|part| (p.clone(), part)))
         .collect::<Result<Vec<_>, _>>()?;
     let film = arbor::farm::merge(&parts)?;
-    arbor::image_io::write_image(&args.out, &film)?;
+    signals.enter(crate::signals::Stage::Render);
+    signals.writing(|| arbor::image_io::write_image(&args.out, &film))?;
+    signals.check()?;
     if !args.quiet {
         let spp = parts.first().map_or(0, |(_, p)| p.sums.spp);
         say!(

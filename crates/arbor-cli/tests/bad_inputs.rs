@@ -107,13 +107,19 @@ fn catalogue() -> Vec<Row> {
     render("instance_of_sphere.xml", 3, "error: instance_of_sphere.xml:30:30: MeshInstance 2: unknown base mesh id '1'\n"),
     // Unknown elements and unused properties: warnings, and the render succeeds.
     render("unknown_element.xml", 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
-    render("unknown_element.json", 0, "warning: unknown_element.json:3:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    render("unknown_element.json", 0, "warning: unknown_element.json:3:5: <Fog> in <Scene> ignored (unknown or unused here)\nwarning: unknown_element.json: the scene has no objects: every image shows only the background\n"),
     render("unused_property.xml", 0, "warning: unused_property.xml:3:24: attribute lens of <Camera> ignored (unknown or unused here)\nwarning: unused_property.xml:29:82: <Faces> in <Sphere> ignored (unknown or unused here)\n"),
     render("nyu_unknown_key.json", 0, "warning: nyu_unknown_key.json:6:75: \"Colour\" in an object ignored (unknown)\n"),
+    // -q hides progress and summaries, not warnings; -qq and --no-warnings hide warnings too.
+    cmd(&["render", "unknown_element.xml", "-q", "-o", "OUT"], 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    cmd(&["render", "unknown_element.xml", "-qq", "-o", "OUT"], 0, ""),
+    cmd(&["render", "unknown_element.xml", "--no-warnings", "-o", "OUT"], 0, ""),
+    // A camera whose up is parallel to its gaze.
+    render("up_parallel_to_gaze.xml", 0, "warning: up_parallel_to_gaze.xml:3:9: Camera 1: Up [0, 0, 2] is parallel to Gaze [0, 0, -1]: the image's orientation is undefined\n"),
     // Empty scenes: no camera is an error; no objects renders the background.
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
-    render("no_objects.xml", 0, ""),
+    render("no_objects.xml", 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\n"),
     render("empty_object.json", 3, "error: empty_object.json:1:1: no top-level \"Scene\" object\n"),
     render("not_a_scene.xml", 3, "error: not_a_scene.xml:1:1: root element is <Mesh>, expected <Scene>\n"),
     // Zero-size images.
@@ -132,7 +138,7 @@ fn catalogue() -> Vec<Row> {
     // Files that cannot be read: I/O errors, exit 4.
     cmd(&["render", "no_such_scene.xml", "-o", "OUT"], 4, "error: no_such_scene.xml: No such file or directory (os error 2)\n"),
     // Limits: --spp on the command line, the flag that lifts them, and the other commands.
-    cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "error: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
+    cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "warning: no_objects.xml: the scene has no objects: every image shows only the background\nerror: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     cmd(&["render", "deep_recursion.xml", "--no-limits", "-o", "OUT"], 0, ""),
     // Merge: a part that is no partial EXR, or missing.
     cmd(&["merge", "truncated.xml", "-o", "OUT"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
@@ -140,7 +146,9 @@ fn catalogue() -> Vec<Row> {
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
     cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
-    // Mesh files given directly.
+    // Mesh files given directly: bench takes them, render and info say so.
+    cmd(&["render", "huge_count.ply", "-o", "OUT"], 3, "error: huge_count.ply: this is a mesh file, not a scene (.xml or .json); `arbor bench huge_count.ply` takes meshes\n"),
+    cmd(&["info", "inf.obj"], 3, "error: inf.obj: this is a mesh file, not a scene (.xml or .json); `arbor bench inf.obj` takes meshes\n"),
     cmd(&["bench", "huge_count.off"], 3, "error: huge_count.off:2: header claims 3000000000 vertices and 2000000000 faces but only 1 lines follow\n"),
     cmd(&["bench", "scene_as.ply"], 3, "error: scene_as.ply:1: not a PLY file (the first line must be `ply`)\n"),
     ]
