@@ -19,6 +19,7 @@
 //! vertex or per face. The header and its size check are in `header.rs`.
 
 mod binary;
+mod counts;
 mod generic;
 mod header;
 
@@ -34,8 +35,15 @@ use crate::{Error, Location, Result};
 /// Parses a PLY file already in memory; `path` is only used in error messages.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let header = parse_header(bytes, path)?;
-    check_sizes(&header, bytes, path)?;
-    let (roles, nv) = plan_roles(&header, path)?;
+    parse_body(&header, bytes, path).map_err(|e| match header.format {
+        Format::Ascii => counts::disagreeing_count(&header, bytes, path).unwrap_or(e),
+        _ => e,
+    })
+}
+
+fn parse_body(header: &Header, bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
+    check_sizes(header, bytes, path)?;
+    let (roles, nv) = plan_roles(header, path)?;
     let faces: u64 = header.elements.iter().filter(|e| e.name == "face").map(|e| e.count).sum();
     let mut out = Out {
         positions: vec_for(nv, "vertices", path)?,
@@ -61,8 +69,8 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
                 read_element(&mut src, e, role, nv, &mut out)?;
             }
         }
-        Format::Le => binary::read_binary::<binary::Le>(bytes, &header, &roles, path, nv, &mut out)?,
-        Format::Be => binary::read_binary::<binary::Be>(bytes, &header, &roles, path, nv, &mut out)?,
+        Format::Le => binary::read_binary::<binary::Le>(bytes, header, &roles, path, nv, &mut out)?,
+        Format::Be => binary::read_binary::<binary::Be>(bytes, header, &roles, path, nv, &mut out)?,
     }
     Ok(TriangleMesh {
         positions: out.positions,
@@ -501,6 +509,20 @@ property float y\nproperty float z\n";
             "m.ply:4:15: list count type must be an integer type, not `float`"
         );
         assert_eq!(err(b"ply\nformat ascii 1.0\nend_header\n"), "m.ply: no `vertex` element");
+    }
+
+    #[test]
+    fn ply_ascii_count_that_disagrees_with_the_data_is_named_at_its_header_line() {
+        let more = CUBE.replace("element vertex 8", "element vertex 9");
+        assert_eq!(
+            err(more.as_bytes()),
+            "m.ply:5: element `vertex` claims 9 entries but the data has 8 (then a line of another shape)"
+        );
+        let fewer = CUBE.replace("element vertex 8", "element vertex 7");
+        assert_eq!(
+            err(fewer.as_bytes()),
+            "m.ply:5: element `vertex` claims 7 entries but the data has 8 before the next element"
+        );
     }
 
     #[test]
