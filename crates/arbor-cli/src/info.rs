@@ -96,7 +96,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         };
         say!("object     {}: {what}", o.name);
     }
-    for w in &desc.warnings {
+    for w in crate::warnings::scene_warnings(&desc) {
         say!("warning    {w}");
     }
     let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
