@@ -4,8 +4,8 @@
 //! `-o` names a folder (created if missing) into which every camera's image goes under the name the
 //! scene gives it, or, when it ends in an image extension, the one image of a scene with one camera (a
 //! scene with several is a usage error: `-o` then names a folder). Every target is checked: an
-//! extension Arbor writes, a folder that exists (or, for the image folder, can be created) and that
-//! accepts a new file (a probe file is created and removed at once, which also answers for root, for
+//! extension Arbor writes, a folder that exists (images and partial EXRs may also name one that can be
+//! created, as their writers create it; `--stats-json` may not) and that accepts a new file (a probe file is created and removed at once, which also answers for root, for
 //! whom permission bits say nothing). Errors name the target file.
 
 use std::path::{Path, PathBuf};
@@ -40,7 +40,7 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
             )));
         }
         check_extension(out).map_err(Failure::Usage)?;
-        check_writable(out, false)?;
+        check_writable(out, true)?;
         return Ok(vec![out.to_path_buf()]);
     }
     let mut targets = Vec::with_capacity(cameras.len());

@@ -179,7 +179,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     }
     let targets = match &slice {
         Some(s) => {
-            crate::outputs::check_writable(&s.out, false)?;
+            crate::outputs::check_writable(&s.out, true)?;
             vec![s.out.clone()]
         }
         None => {
