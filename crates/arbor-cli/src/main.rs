@@ -91,29 +91,42 @@ pub fn shown(path: &Option<PathBuf>) -> String {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = signals::Signals::install().and_then(|signals| match cli.command {
+    let signals = match signals::Signals::install() {
+        Ok(s) => s,
+        Err(f) => return report(f),
+    };
+    let result = match cli.command {
         Command::Render(args) => render::run(args, &signals),
         Command::Info(args) => info::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Merge(args) => merge::run(args, &signals),
-    });
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::TooDifferent) => ExitCode::from(1),
-        Err(Failure::Usage(msg)) => {
+        // Through the watcher's lock, so that the watcher cannot report the same signal a second time.
+        Err(Failure::Interrupted(code)) => signals.exit(code),
+        Err(f) => report(f),
+    }
+}
+
+/// Prints a failure and gives its exit code.
+fn report(failure: Failure) -> ExitCode {
+    match failure {
+        Failure::TooDifferent => ExitCode::from(1),
+        Failure::Usage(msg) => {
             eprintln!("error: {msg}");
             ExitCode::from(2)
         }
-        Err(Failure::Interrupted(code)) => {
+        Failure::Interrupted(code) => {
             eprintln!("{}", signals::MESSAGE);
             ExitCode::from(code)
         }
-        Err(Failure::OutOfMemory(msg)) => {
+        Failure::OutOfMemory(msg) => {
             eprintln!("error: {msg}");
             ExitCode::from(4)
         }
-        Err(Failure::Arbor(e)) => {
+        Failure::Arbor(e) => {
             eprintln!("error: {e}");
             ExitCode::from(if e.is_io() { 4 } else { 3 })
         }

@@ -90,6 +90,12 @@ impl Signals {
         out
     }
 
+    /// Ends the process for the signal `code` stands for, unless the watcher is already doing so.
+    pub fn exit(&self, code: u8) -> ! {
+        let _held = lock(&self.state);
+        exit_now(code)
+    }
+
     /// `Err(Interrupted)` once a signal came.
     pub fn check(&self) -> Result<(), Failure> {
         match lock(&self.state).code {

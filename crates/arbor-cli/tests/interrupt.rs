@@ -32,6 +32,10 @@ fn signal_and_wait(mut child: Child, signal: &str, delay: Duration) -> Option<i3
     loop {
         if let Some(status) = child.try_wait().unwrap() {
             assert!(start.elapsed() < Duration::from_secs(1), "stopped {:?} after SIG{signal}", start.elapsed());
+            let mut err = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+            let said = "interrupted: an image whose render was stopped is not written\n";
+            assert_eq!(err, said, "SIG{signal} must be reported once");
             return status.code();
         }
         if start.elapsed() > Duration::from_secs(60) {
