@@ -113,6 +113,16 @@ mod tests {
 
     #[cfg(target_os = "linux")]
     #[test]
+    fn load_bytes_reads_no_more_than_the_length_at_open() {
+        // A procfs file is regular and says it is empty, yet reading it yields text: only its stated
+        // length (none) is read, as for a file that grows while it is read.
+        let status = Path::new("/proc/self/status");
+        assert!(!std::fs::read(status).unwrap().is_empty());
+        assert_eq!(load_bytes(status).unwrap(), b"");
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
     fn load_bytes_refuses_a_named_pipe_without_blocking() {
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("pipe.ply");

@@ -22,8 +22,8 @@ pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let mut r = Reader { path, lines: Lines::new(bytes, 1) };
     let (nv, nf) = r.header()?;
     let mut mesh = TriangleMesh {
-        positions: super::vec_for(nv as u64, "vertices", path)?,
-        indices: super::vec_for(nf as u64, "faces", path)?,
+        positions: super::vec_for(nv, "vertices", path)?,
+        indices: super::vec_for(nf, "faces", path)?,
         ..Default::default()
     };
     for i in 0..nv {
