@@ -25,6 +25,9 @@ pub struct MergeArgs {
 /// Runs `arbor merge`.
 pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Failure> {
     let start = std::time::Instant::now();
+    // Checked before the parts are read: they may be many and large.
+    crate::outputs::check_extension(&args.out).map_err(Failure::Usage)?;
+    crate::outputs::check_writable(&args.out, true)?;
     let parts = args
         .parts
         .iter()

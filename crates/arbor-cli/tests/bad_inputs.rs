@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// One run: the arguments after `arbor` (`OUT` stands for the output folder), the exit code, stderr.
+/// One run: the arguments after `arbor` (`OUT` at the start of one stands for the output folder), the exit
+/// code, stderr.
 struct Row {
     args: Vec<&'static str>,
     code: i32,
@@ -144,8 +145,9 @@ fn catalogue() -> Vec<Row> {
     cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "warning: no_objects.xml: the scene has no objects: every image shows only the background\nerror: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     cmd(&["render", "deep_recursion.xml", "--no-limits", "-o", "OUT"], 0, ""),
     // Merge: a part that is no partial EXR, or missing.
-    cmd(&["merge", "truncated.xml", "-o", "OUT"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
-    cmd(&["merge", "no_such_part.exr", "-o", "OUT"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
+    cmd(&["merge", "truncated.xml", "-o", "OUT/merged.png"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
+    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg\n"),
+    cmd(&["merge", "no_such_part.exr", "-o", "OUT/merged.png"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
     cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
@@ -159,7 +161,15 @@ fn catalogue() -> Vec<Row> {
 
 /// What went wrong with one row, if anything.
 fn run(row: &Row, dir: &Path, out: &Path) -> Result<(), String> {
-    let args: Vec<&str> = row.args.iter().map(|a| if *a == "OUT" { out.to_str().unwrap() } else { a }).collect();
+    let args: Vec<String> = row
+        .args
+        .iter()
+        .map(|a| match a.strip_prefix("OUT") {
+            Some(rest) => format!("{}{rest}", out.display()),
+            None => a.to_string(),
+        })
+        .collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let err_path = out.with_extension("stderr");
     let err_file = std::fs::File::create(&err_path).unwrap();
     let mut command = limited(&args);
