@@ -62,6 +62,7 @@ fn catalogue() -> Vec<Row> {
     // Header counts that disagree with the data: the element named at its header line.
     render("mesh_vertex_count_high_ply.xml", 3, "error: vertex_count_too_high.ply:3: element `vertex` claims 4 entries but the data has 3 (then a line of another shape)\n"),
     render("mesh_vertex_count_low_ply.xml", 3, "error: vertex_count_too_low.ply:3: element `vertex` claims 2 entries but the data has 3 before the next element\n"),
+    render("mesh_vertex_count_binary_ply.xml", 3, "error: vertex_count_binary.ply:3: element `vertex` claims 4 entries but the data holds 3 (then the elements after it fill the file exactly)\n"),
     // Non-numbers.
     render("position_not_a_number.xml", 3, "error: position_not_a_number.xml:4:13: <Position>: malformed number 'zero'\n"),
     render("resolution_not_integer.xml", 3, "error: resolution_not_integer.xml:9:13: <ImageResolution>: malformed integer '8.5'\n"),

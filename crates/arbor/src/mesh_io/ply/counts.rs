@@ -12,6 +12,7 @@
 
 use std::path::Path;
 
+use super::binary::{read_int, Order};
 use super::header::{Element, Header, Kind};
 use crate::mesh_io::{Lines, Tokens};
 use crate::{Error, Location};
@@ -78,4 +79,83 @@ fn fits(e: &Element, line: &[u8]) -> bool {
         }
     }
     toks.next().is_none()
+}
+
+/// How far from its claim a binary element's count is looked for.
+const BINARY_SEARCH: u64 = 64;
+
+/// The element whose count disagrees with the binary body, as an error at its header line.
+///
+/// Binary data has no lines to match, so the counts are tried instead: an element of fixed-size entries
+/// whose claimed count leaves the elements after it unreadable, while a count at most
+/// [`BINARY_SEARCH`] away lets them fill the rest of the file exactly (faces with at least three
+/// corners, every index below the vertex count), is the one named. Elements after the first one with
+/// lists are not tried: where they start depends on every list before them.
+pub(super) fn disagreeing_count_binary<E: Order>(h: &Header, bytes: &[u8], path: &Path) -> Option<Error> {
+    let body = &bytes[h.body..];
+    let mut at = 0u64;
+    for (i, e) in h.elements.iter().enumerate() {
+        let stride = e.stride()? as u64;
+        let tail = &h.elements[i + 1..];
+        if tail.is_empty() {
+            return None;
+        }
+        let vertices = |n: u64| if e.name == "vertex" { n } else { vertex_count(h) };
+        if ends_exactly::<E>(tail, body, at + e.count * stride, vertices(e.count)) {
+            at += e.count * stride;
+            continue;
+        }
+        let candidates = (1..=BINARY_SEARCH).flat_map(|d| [e.count.checked_sub(d), e.count.checked_add(d)]).flatten();
+        for n in candidates {
+            if ends_exactly::<E>(tail, body, at + n * stride, vertices(n)) {
+                let msg = format!(
+                    "element `{}` claims {} entries but the data holds {n} (then the elements after it fill the \
+                     file exactly)",
+                    e.name, e.count
+                );
+                return Some(Error::input(Location::at(path, e.line, 0), msg));
+            }
+        }
+        return None;
+    }
+    None
+}
+
+fn vertex_count(h: &Header) -> u64 {
+    h.elements.iter().find(|e| e.name == "vertex").map_or(0, |e| e.count)
+}
+
+/// True when `elements`, read from `start`, end exactly at the end of `body` with plausible faces.
+fn ends_exactly<E: Order>(elements: &[Element], body: &[u8], start: u64, vertices: u64) -> bool {
+    let Ok(mut pos) = usize::try_from(start) else { return false };
+    for e in elements {
+        let face = e.name == "face";
+        for _ in 0..e.count {
+            for p in &e.props {
+                match p.kind {
+                    Kind::Scalar(t) => pos += t.size(),
+                    Kind::List { count, item } => {
+                        let Some(b) = body.get(pos..pos + count.size()) else { return false };
+                        let k = read_int::<E>(count, b);
+                        pos += count.size();
+                        let indices = face && (p.name == "vertex_indices" || p.name == "vertex_index");
+                        if k < 0 || (indices && k < 3) {
+                            return false;
+                        }
+                        for _ in 0..k {
+                            let Some(b) = body.get(pos..pos + item.size()) else { return false };
+                            if indices && !(0..vertices as i64).contains(&read_int::<E>(item, b)) {
+                                return false;
+                            }
+                            pos += item.size();
+                        }
+                    }
+                }
+                if pos > body.len() {
+                    return false;
+                }
+            }
+        }
+    }
+    pos == body.len()
 }

@@ -35,9 +35,13 @@ use crate::{Error, Location, Result};
 /// Parses a PLY file already in memory; `path` is only used in error messages.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let header = parse_header(bytes, path)?;
-    parse_body(&header, bytes, path).map_err(|e| match header.format {
-        Format::Ascii => counts::disagreeing_count(&header, bytes, path).unwrap_or(e),
-        _ => e,
+    parse_body(&header, bytes, path).map_err(|e| {
+        let named = match header.format {
+            Format::Ascii => counts::disagreeing_count(&header, bytes, path),
+            Format::Le => counts::disagreeing_count_binary::<binary::Le>(&header, bytes, path),
+            Format::Be => counts::disagreeing_count_binary::<binary::Be>(&header, bytes, path),
+        };
+        named.unwrap_or(e)
     })
 }
 
@@ -523,6 +527,27 @@ property float y\nproperty float z\n";
             err(fewer.as_bytes()),
             "m.ply:5: element `vertex` claims 7 entries but the data has 8 before the next element"
         );
+    }
+
+    #[test]
+    fn ply_binary_count_that_disagrees_with_the_data_is_named_at_its_header_line() {
+        // Four vertices and two triangles, the header claiming one vertex more or less.
+        for (le, claim) in [(true, 5), (false, 3), (true, 3)] {
+            let header = format!(
+                "element vertex {claim}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face 2\nproperty list uchar int vertex_indices\n"
+            );
+            let mut w = W::new(le, &header);
+            for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                w.f32(x).f32(y).f32(0.0);
+            }
+            w.u8(3).i32(0).i32(1).i32(2).u8(3).i32(0).i32(2).i32(3);
+            let want = format!(
+                "m.ply:3: element `vertex` claims {claim} entries but the data holds 4 (then the elements after it \
+                 fill the file exactly)"
+            );
+            assert_eq!(err(&w.buf), want, "{} claim {claim}", if le { "le" } else { "be" });
+        }
     }
 
     #[test]
