@@ -151,6 +151,8 @@ pub fn limits(no_limits: bool) -> SceneLimits {
 pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     args.threads.apply()?;
     let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
+    // Checked before any file is read.
+    let spec = accel_spec(args.accel, &args.accel_params)?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
     let parse_time = t0.elapsed();
@@ -191,7 +193,6 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         crate::outputs::check_writable(file, false)?;
     }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
-    let spec = accel_spec(args.accel, &args.accel_params)?;
     let scene = Scene::build(desc, &spec, env)?;
     signals.enter(Stage::Render);
     let cull = if args.cull {

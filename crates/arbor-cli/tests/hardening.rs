@@ -345,7 +345,7 @@ fn hardening_short_render_prints_no_progress_to_a_log() {
 fn hardening_help_lists_every_command() {
     let tmp = tempfile::tempdir().unwrap();
     let help = String::from_utf8_lossy(&arbor(&["--help"], tmp.path()).stdout).into_owned();
-    assert!(help.contains("render, merge, info, bench and diff"), "{help}");
+    assert!(help.contains("render, info, bench, diff and merge"), "{help}");
     for command in ["render", "info", "bench", "merge", "diff"] {
         assert!(help.lines().any(|l| l.trim_start().starts_with(command)), "no {command} in:\n{help}");
     }
