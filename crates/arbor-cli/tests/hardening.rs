@@ -350,3 +350,35 @@ fn hardening_help_lists_every_command() {
         assert!(help.lines().any(|l| l.trim_start().starts_with(command)), "no {command} in:\n{help}");
     }
 }
+
+#[test]
+fn hardening_signal_stops_bench_and_info_too() {
+    let tmp = tempfile::tempdir().unwrap();
+    grid_ply(&tmp.path().join("big.ply"), 1001);
+    std::fs::write(tmp.path().join("s.xml"), scene(&mesh_object("big.ply"), "big.png")).unwrap();
+    for args in [&["bench", "sphere:3000000", "--runs", "1"][..], &["info", "s.xml", "--accel", "kdtree"][..]] {
+        let mut child = Command::new(ARBOR)
+            .args(args)
+            .current_dir(tmp.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(500));
+        assert!(child.try_wait().unwrap().is_none(), "{args:?} ended before the signal");
+        assert!(Command::new("kill").arg("-TERM").arg(child.id().to_string()).status().unwrap().success());
+        let sent = Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status;
+            }
+            if sent.elapsed() > Duration::from_secs(30) {
+                let _ = child.kill();
+                panic!("{args:?} did not stop within 30 s of SIGTERM");
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        assert_eq!(status.code(), Some(143), "{args:?}");
+        assert!(sent.elapsed() < Duration::from_secs(1), "{args:?} stopped {:?} after SIGTERM", sent.elapsed());
+    }
+}
