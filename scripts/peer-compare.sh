@@ -5,7 +5,7 @@
 #   PEERBENCH=/tmp/peerbench  a built copy of ../shared/peerbench (cp -r, cargo build --release,
 #                             ./get-embree4.sh); ARBOR=target/release/arbor; OUT=/tmp/peer-compare
 # For each mesh: peerbench dumps its rays and Embree 4's hits once (OUT/rays-NAME), then every round
-# runs peerbench (embree4,obvhs) and `arbor bench MESH --rays DIR` one after the other at each thread
+# runs peerbench (embree4,obvhs) and `arbor bench MESH --ray-dir DIR` one after the other at each thread
 # count, so that machine load drifts hit both alike. Prints every raw line to OUT/raw.txt and a
 # Markdown table of medians over rounds, with Arbor's ratios to each peer.
 set -euo pipefail
@@ -38,7 +38,7 @@ for mesh in "$@"; do
     for t in $threads; do
       echo "# $name round $r threads $t" >&2
       "$pb" --peers "$peers" --threads "$t" "$mesh" | grep '^peer=' | sed "s|\$| round=$r mesh_name=$name|" >> "$raw"
-      "$arbor" bench "$mesh" --rays "$rays" --threads "$t" --accel "$kinds" | grep '^peer=' \
+      "$arbor" bench "$mesh" --ray-dir "$rays" --threads "$t" --accel "$kinds" | grep '^peer=' \
         | sed "s|\$| round=$r mesh_name=$name|" >> "$raw"
     done
   done

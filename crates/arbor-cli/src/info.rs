@@ -92,7 +92,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         };
         say!("object     {}: {what}", o.name);
     }
-    for w in &desc.warnings {
+    for w in crate::warnings::scene_warnings(&desc) {
         say!("warning    {w}");
     }
     let scene = Scene::build(desc, &spec, None)?;

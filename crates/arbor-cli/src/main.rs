@@ -2,7 +2,8 @@
 //! acceleration structures, compare images.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
-//! 4 I/O failure, 130 and 143 when `render` was stopped by SIGINT or SIGTERM (no image written).
+//! 4 I/O failure or not enough memory, 130 and 143 when stopped by SIGINT or SIGTERM (at any stage;
+//! no image written).
 
 /// Prints a line to standard output. A closed pipe (`arbor info | head -1`) ends the program quietly
 /// instead of panicking, as command-line tools do.
@@ -11,13 +12,17 @@ macro_rules! say {
 }
 
 mod bench;
-mod bench_rays;
 mod diff;
 mod info;
+mod memory;
 mod merge;
+mod outputs;
 mod progress;
 mod render;
+mod signals;
 mod slice;
+mod threads;
+mod warnings;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,6 +63,8 @@ pub enum Failure {
     Arbor(arbor::Error),
     /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
     Interrupted(u8),
+    /// A buffer could not be allocated (exit 4, like other failures of the machine rather than the input).
+    OutOfMemory(String),
 }
 
 impl From<arbor::Error> for Failure {
@@ -77,17 +84,6 @@ pub fn say_line(args: std::fmt::Arguments) {
     }
 }
 
-/// Which threads to use: `--threads N`, or all cores.
-pub fn set_threads(threads: Option<usize>) -> Result<(), Failure> {
-    if let Some(n) = threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build_global()
-            .map_err(|e| arbor::Error::Invalid(format!("cannot start {n} threads: {e}")))?;
-    }
-    Ok(())
-}
-
 /// The scene argument as a display name.
 pub fn shown(path: &Option<PathBuf>) -> String {
     path.as_ref().map_or_else(|| "(built-in example)".to_string(), |p| p.display().to_string())
@@ -95,25 +91,42 @@ pub fn shown(path: &Option<PathBuf>) -> String {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let signals = match signals::Signals::install() {
+        Ok(s) => s,
+        Err(f) => return report(f),
+    };
     let result = match cli.command {
-        Command::Render(args) => render::run(args),
+        Command::Render(args) => render::run(args, &signals),
         Command::Info(args) => info::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
-        Command::Merge(args) => merge::run(args),
+        Command::Merge(args) => merge::run(args, &signals),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::TooDifferent) => ExitCode::from(1),
-        Err(Failure::Usage(msg)) => {
+        // Through the watcher's lock, so that the watcher cannot report the same signal a second time.
+        Err(Failure::Interrupted(code)) => signals.exit(code),
+        Err(f) => report(f),
+    }
+}
+
+/// Prints a failure and gives its exit code.
+fn report(failure: Failure) -> ExitCode {
+    match failure {
+        Failure::TooDifferent => ExitCode::from(1),
+        Failure::Usage(msg) => {
             eprintln!("error: {msg}");
             ExitCode::from(2)
         }
-        Err(Failure::Interrupted(code)) => {
-            eprintln!("interrupted: an image whose render was stopped is not written");
+        Failure::Interrupted(code) => {
+            eprintln!("{}", signals::MESSAGE);
             ExitCode::from(code)
         }
-        Err(Failure::Arbor(e)) => {
+        Failure::OutOfMemory(msg) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(4)
+        }
+        Failure::Arbor(e) => {
             eprintln!("error: {e}");
             ExitCode::from(if e.is_io() { 4 } else { 3 })
         }

@@ -14,7 +14,7 @@ pub struct MergeArgs {
     /// Partial EXR files written by `arbor render --tile/--sample-offset/--sample-count` (any order).
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
-    /// The merged image; the extension picks the format (.png, .ppm, .exr).
+    /// The merged image; the extension picks the format (.png, .ppm, .exr, .jpg, .jpeg).
     #[arg(short = 'o', long = "out", value_name = "IMAGE")]
     pub out: PathBuf,
     /// No summary line (`Saved: IMAGE` stays).
@@ -23,15 +23,20 @@ pub struct MergeArgs {
 }
 
 /// Runs `arbor merge`.
-pub fn run(args: MergeArgs) -> Result<(), Failure> {
+pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Failure> {
     let start = std::time::Instant::now();
+    // Checked before the parts are read: they may be many and large.
+    crate::outputs::check_extension(&args.out).map_err(Failure::Usage)?;
+    crate::outputs::check_writable(&args.out, true)?;
     let parts = args
         .parts
         .iter()
         .map(|p| arbor::farm::read_partial(p).map(|part| (p.clone(), part)))
         .collect::<Result<Vec<_>, _>>()?;
     let film = arbor::farm::merge(&parts)?;
-    arbor::image_io::write_image(&args.out, &film)?;
+    signals.enter(crate::signals::Stage::Render);
+    signals.writing(|| arbor::image_io::write_image(&args.out, &film))?;
+    signals.check()?;
     if !args.quiet {
         let spp = parts.first().map_or(0, |(_, p)| p.sums.spp);
         say!(

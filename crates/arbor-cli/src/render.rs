@@ -3,14 +3,13 @@
 //! same numbers as JSON (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs
 //! instead ([`crate::slice`]).
 //!
-//! SIGINT and SIGTERM stop the render between tiles: the image being rendered is not written (the
-//! previous file, if any, stays as it was; images are written whole, by rename), and the command exits
-//! 130 or 143. A second signal while the first is being honoured (e.g. during a long mesh load) exits at
-//! once with the same code.
+//! Every output path is worked out and checked before the scene is built ([`crate::outputs`]), and the
+//! memory an image needs is reserved before it is rendered (exit 4 when there is not enough). SIGINT and
+//! SIGTERM stop the command at any stage ([`crate::signals`]): the image being rendered is not written
+//! (the previous file, if any, stays as it was; images are written whole, by rename), and the command
+//! exits 130 or 143.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::Instant;
 
 use arbor::accel::{AccelConfig, AccelKind};
@@ -23,6 +22,7 @@ use clap::Args;
 use serde_json::json;
 
 use crate::progress::Progress;
+use crate::signals::{Signals, Stage};
 use crate::slice::{identity, Slice, SliceArgs};
 use crate::Failure;
 
@@ -35,8 +35,9 @@ const EXAMPLE: &str = include_str!("../../../examples/cornell_box.xml");
 pub struct RenderArgs {
     /// Scene file (.xml or .json). Without one, renders the built-in example Cornell box.
     pub scene: Option<PathBuf>,
-    /// Folder for the images (created if missing); each camera's file name comes from the scene. For a
-    /// slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR file.
+    /// Folder for the images (created if missing); each camera's file name comes from the scene. A name
+    /// ending in an image extension (.png, .ppm, .exr, .jpg, .jpeg) is the image of a one-camera scene.
+    /// For a slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
     /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.
@@ -48,9 +49,8 @@ pub struct RenderArgs {
     /// Samples per pixel, overriding the scene's NumSamples.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub spp: Option<u32>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: crate::threads::ThreadsArg,
     /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
     /// (px nx py ny pz nz).
     #[arg(long)]
@@ -78,9 +78,13 @@ pub struct RenderArgs {
     /// Write the render's numbers (scene, camera, size, window, samples, times, rays) as JSON to FILE.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
-    /// No progress bar and no summary lines (`Saved: PATH` lines stay).
-    #[arg(short, long)]
-    pub quiet: bool,
+    /// No progress and no summary lines (`Saved: PATH` lines and warnings stay); twice (-qq) also no
+    /// warnings.
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    pub quiet: u8,
+    /// No warnings (unknown elements, unused properties, suspicious cameras and scenes).
+    #[arg(long)]
+    pub no_warnings: bool,
     /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
     /// depth (64) and pixels x samples (2^34) that guard against crafted scene files.
     #[arg(long)]
@@ -105,37 +109,6 @@ pub fn parse_crop(s: &str) -> Result<(u32, u32, u32, u32), String> {
     }
 }
 
-/// Flags set by SIGINT and SIGTERM: `cancel` stops the render, the other two say which signal came.
-struct Signals {
-    cancel: Arc<AtomicBool>,
-    int: Arc<AtomicBool>,
-    term: Arc<AtomicBool>,
-}
-
-impl Signals {
-    fn install() -> Result<Signals, Failure> {
-        use signal_hook::consts::{SIGINT, SIGTERM};
-        let s = Signals { cancel: Arc::default(), int: Arc::default(), term: Arc::default() };
-        for (sig, which, code) in [(SIGINT, &s.int, 130), (SIGTERM, &s.term, 143)] {
-            let ok = signal_hook::flag::register_conditional_shutdown(sig, code, Arc::clone(&s.cancel))
-                .and_then(|_| signal_hook::flag::register(sig, Arc::clone(which)))
-                .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&s.cancel)));
-            ok.map_err(|e| arbor::Error::Invalid(format!("cannot install a signal handler: {e}")))?;
-        }
-        Ok(s)
-    }
-
-    /// `Err(Interrupted)` once a signal came.
-    fn check(&self) -> Result<(), Failure> {
-        match (self.int.load(Ordering::SeqCst), self.term.load(Ordering::SeqCst)) {
-            (true, _) => Err(Failure::Interrupted(130)),
-            (_, true) => Err(Failure::Interrupted(143)),
-            _ if self.cancel.load(Ordering::SeqCst) => Err(Failure::Interrupted(130)),
-            _ => Ok(()),
-        }
-    }
-}
-
 /// The structure and parameters named on the command line; a parameter that does not apply, does not
 /// read or lies outside its range is a usage error, found before any file is read.
 pub fn accel_spec(kind: AccelKind, params: &[String]) -> Result<AccelConfig, Failure> {
@@ -145,9 +118,22 @@ pub fn accel_spec(kind: AccelKind, params: &[String]) -> Result<AccelConfig, Fai
 /// Reads the scene named on the command line, or the built-in example.
 pub fn read_scene(scene: &Option<PathBuf>) -> Result<SceneDesc, Failure> {
     Ok(match scene {
+        Some(path) if is_mesh_file(path) => {
+            let msg = format!(
+                "this is a mesh file, not a scene (.xml or .json); `arbor bench {}` takes meshes",
+                path.display()
+            );
+            return Err(arbor::Error::input(arbor::Location::file(path), msg).into());
+        }
         Some(path) => load_desc(path)?,
         None => parse_desc(EXAMPLE, Path::new(EXAMPLE_NAME))?,
     })
+}
+
+/// True for the extensions of the mesh formats Arbor reads.
+pub fn is_mesh_file(path: &Path) -> bool {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    matches!(ext.as_deref(), Some("ply" | "obj" | "off"))
 }
 
 /// The limits a scene is checked against: the defaults, or none with `--no-limits`.
@@ -160,37 +146,19 @@ pub fn limits(no_limits: bool) -> SceneLimits {
 }
 
 /// Runs `arbor render`.
-pub fn run(args: RenderArgs) -> Result<(), Failure> {
-    let signals = Signals::install()?;
-    crate::set_threads(args.threads)?;
+pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
+    args.threads.apply()?;
     let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
+    // Checked before any file is read.
     let spec = accel_spec(args.accel, &args.accel_params)?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
     let parse_time = t0.elapsed();
-    for w in &desc.warnings {
-        if !args.quiet {
+    let cameras = chosen_cameras(&args, &desc)?;
+    if args.quiet < 2 && !args.no_warnings {
+        for w in crate::warnings::scene_warnings(&desc) {
             eprintln!("warning: {w}");
         }
-    }
-    let cameras: Vec<usize> = match &args.camera {
-        None => (0..desc.cameras.len()).collect(),
-        Some(id) => {
-            let found: Vec<usize> = (0..desc.cameras.len()).filter(|&i| &desc.cameras[i].id == id).collect();
-            if found.is_empty() {
-                let ids: Vec<&str> = desc.cameras.iter().map(|c| c.id.as_str()).collect();
-                return Err(arbor::Error::Invalid(format!(
-                    "{}: no camera with id '{id}' (cameras: {})",
-                    crate::shown(&args.scene),
-                    ids.join(", ")
-                ))
-                .into());
-            }
-            found
-        }
-    };
-    if cameras.is_empty() {
-        return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
     }
     if slice.is_some() && cameras.len() != 1 {
         return Err(Failure::Usage(format!(
@@ -200,8 +168,31 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         )));
     }
     check_limits(&desc, args.spp, &limits(args.no_limits))?;
+    if let Some((_, _, x1, y1)) = args.crop {
+        if let Some(cam) = cameras.iter().map(|&c| &desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
+            return Err(arbor::Error::Invalid(format!(
+                "--crop reaches pixel ({x1}, {y1}) but camera '{}' is {}x{}",
+                cam.id, cam.width, cam.height
+            ))
+            .into());
+        }
+    }
+    let targets = match &slice {
+        Some(s) => {
+            crate::outputs::check_writable(&s.out, true)?;
+            vec![s.out.clone()]
+        }
+        None => {
+            let cams: Vec<_> = cameras.iter().map(|&c| &desc.cameras[c]).collect();
+            crate::outputs::image_targets(&args.out, &cams)?
+        }
+    };
+    if let Some(file) = &args.stats_json {
+        crate::outputs::check_writable(file, false)?;
+    }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
     let scene = Scene::build(desc, &spec, env)?;
+    signals.enter(Stage::Render);
     let cull = if args.cull {
         Some(true)
     } else if args.no_cull {
@@ -215,19 +206,10 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         debug: args.debug,
         crop: args.crop,
         samples: None,
-        cancel: Some(Arc::clone(&signals.cancel)),
+        cancel: Some(signals.cancel_flag()),
     };
-    if let Some((_, _, x1, y1)) = args.crop {
-        if let Some(cam) = cameras.iter().map(|&c| &scene.desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
-            return Err(arbor::Error::Invalid(format!(
-                "--crop reaches pixel ({x1}, {y1}) but camera '{}' is {}x{}",
-                cam.id, cam.width, cam.height
-            ))
-            .into());
-        }
-    }
     let mut records = Vec::new();
-    for &c in &cameras {
+    for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.desc.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         let (path, stats, window) = match &slice {
@@ -238,28 +220,31 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
                     None => EXAMPLE.as_bytes().to_vec(),
                 };
                 let id = identity(&scene_bytes, &cam.id, spp, cull, args.env.as_deref());
-                let bar = Progress::new(args.quiet, pixels(opts.crop, cam.width, cam.height), &cam.image_name);
+                let window = arbor::render::crop_window(opts.crop, cam.width, cam.height);
+                crate::memory::reserve_for(cam.width, cam.height, window, true)?;
+                let bar = Progress::new(args.quiet > 0, pixels(opts.crop, cam.width, cam.height), &cam.image_name);
                 signals.check()?;
                 let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total));
                 bar.finish();
                 signals.check()?;
                 let window = sums.window;
-                write_partial(&s.out, &Partial { identity: id, camera: cam.id.clone(), sums })?;
-                (s.out.clone(), stats, window)
+                signals.writing(|| write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), sums }))?;
+                (target, stats, window)
             }
             None => {
-                let path = args.out.join(&cam.image_name);
-                let bar = Progress::new(args.quiet, pixels(base.crop, cam.width, cam.height), &cam.image_name);
+                let window = arbor::render::crop_window(base.crop, cam.width, cam.height);
+                crate::memory::reserve_for(cam.width, cam.height, window, false)?;
+                let bar = Progress::new(args.quiet > 0, pixels(base.crop, cam.width, cam.height), &cam.image_name);
                 signals.check()?;
                 let (film, stats) = render(&scene, c, &base, &|done, total| bar.set(done, total));
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                arbor::image_io::write_image(&path, &film)?;
-                (path, stats, arbor::render::crop_window(base.crop, cam.width, cam.height))
+                signals.writing(|| arbor::image_io::write_image(&target, &film))?;
+                (target, stats, window)
             }
         };
-        if !args.quiet {
+        if args.quiet == 0 {
             summary(&args, &scene, &path, window, &stats, parse_time);
         }
         say!("Saved: {}", path.display());
@@ -289,10 +274,34 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     if let Some(file) = &args.stats_json {
         let text = serde_json::to_string_pretty(&json!({ "images": records }))
             .map_err(|e| arbor::Error::Invalid(format!("cannot encode the statistics: {e}")))?;
-        std::fs::write(file, text + "\n").map_err(|e| arbor::Error::io(file, e))?;
+        signals.writing(|| std::fs::write(file, text + "\n")).map_err(|e| arbor::Error::io(file, e))?;
     }
     // A signal during the last write let that (atomic) write finish; the run still reports it.
     signals.check()
+}
+
+/// The cameras to render: all, or the one `--camera` names.
+fn chosen_cameras(args: &RenderArgs, desc: &SceneDesc) -> Result<Vec<usize>, Failure> {
+    let cameras: Vec<usize> = match &args.camera {
+        None => (0..desc.cameras.len()).collect(),
+        Some(id) => {
+            let found: Vec<usize> = (0..desc.cameras.len()).filter(|&i| &desc.cameras[i].id == id).collect();
+            if found.is_empty() {
+                let ids: Vec<&str> = desc.cameras.iter().map(|c| c.id.as_str()).collect();
+                return Err(arbor::Error::Invalid(format!(
+                    "{}: no camera with id '{id}' (cameras: {})",
+                    crate::shown(&args.scene),
+                    ids.join(", ")
+                ))
+                .into());
+            }
+            found
+        }
+    };
+    if cameras.is_empty() {
+        return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", crate::shown(&args.scene))).into());
+    }
+    Ok(cameras)
 }
 
 /// Pixels in the window of a `w` x `h` frame.

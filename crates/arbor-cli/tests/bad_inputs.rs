@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// One run: the arguments after `arbor` (`OUT` stands for the output folder), the exit code, stderr.
+/// One run: the arguments after `arbor` (`OUT` at the start of one stands for the output folder), the exit
+/// code, stderr.
 struct Row {
     args: Vec<&'static str>,
     code: i32,
@@ -58,6 +59,10 @@ fn catalogue() -> Vec<Row> {
     render("resolution_one_number.xml", 3, "error: resolution_one_number.xml:9:13: <ImageResolution>: expected two positive integers\n"),
     render("position_two_numbers.json", 3, "error: position_two_numbers.json:6:9: <Position>: expected 3 numbers, found 2\n"),
     render("nyu_color_two_numbers.json", 3, "error: nyu_color_two_numbers.json:5:29: \"Color\": expected an array of 3 numbers\n"),
+    // Header counts that disagree with the data: the element named at its header line.
+    render("mesh_vertex_count_high_ply.xml", 3, "error: vertex_count_too_high.ply:3: element `vertex` claims 4 entries but the data has 3 (then a line of another shape)\n"),
+    render("mesh_vertex_count_low_ply.xml", 3, "error: vertex_count_too_low.ply:3: element `vertex` claims 2 entries but the data has 3 before the next element\n"),
+    render("mesh_vertex_count_binary_ply.xml", 3, "error: vertex_count_binary.ply:3: element `vertex` claims 4 entries but the data holds 3 (then the elements after it fill the file exactly)\n"),
     // Non-numbers.
     render("position_not_a_number.xml", 3, "error: position_not_a_number.xml:4:13: <Position>: malformed number 'zero'\n"),
     render("resolution_not_integer.xml", 3, "error: resolution_not_integer.xml:9:13: <ImageResolution>: malformed integer '8.5'\n"),
@@ -107,13 +112,19 @@ fn catalogue() -> Vec<Row> {
     render("instance_of_sphere.xml", 3, "error: instance_of_sphere.xml:30:30: MeshInstance 2: unknown base mesh id '1'\n"),
     // Unknown elements and unused properties: warnings, and the render succeeds.
     render("unknown_element.xml", 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
-    render("unknown_element.json", 0, "warning: unknown_element.json:3:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    render("unknown_element.json", 0, "warning: unknown_element.json:3:5: <Fog> in <Scene> ignored (unknown or unused here)\nwarning: unknown_element.json: the scene has no objects: every image shows only the background\n"),
     render("unused_property.xml", 0, "warning: unused_property.xml:3:24: attribute lens of <Camera> ignored (unknown or unused here)\nwarning: unused_property.xml:29:82: <Faces> in <Sphere> ignored (unknown or unused here)\n"),
     render("nyu_unknown_key.json", 0, "warning: nyu_unknown_key.json:6:75: \"Colour\" in an object ignored (unknown)\n"),
+    // -q hides progress and summaries, not warnings; -qq and --no-warnings hide warnings too.
+    cmd(&["render", "unknown_element.xml", "-q", "-o", "OUT"], 0, "warning: unknown_element.xml:2:5: <Fog> in <Scene> ignored (unknown or unused here)\n"),
+    cmd(&["render", "unknown_element.xml", "-qq", "-o", "OUT"], 0, ""),
+    cmd(&["render", "unknown_element.xml", "--no-warnings", "-o", "OUT"], 0, ""),
+    // A camera whose up is parallel to its gaze.
+    render("up_parallel_to_gaze.xml", 0, "warning: up_parallel_to_gaze.xml:3:9: Camera 1: Up [0, 0, 2] is parallel to Gaze [0, 0, -1]: the image's orientation is undefined\n"),
     // Empty scenes: no camera is an error; no objects renders the background.
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
-    render("no_objects.xml", 0, ""),
+    render("no_objects.xml", 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\n"),
     render("empty_object.json", 3, "error: empty_object.json:1:1: no top-level \"Scene\" object\n"),
     render("not_a_scene.xml", 3, "error: not_a_scene.xml:1:1: root element is <Mesh>, expected <Scene>\n"),
     // Zero-size images.
@@ -132,7 +143,7 @@ fn catalogue() -> Vec<Row> {
     // Files that cannot be read: I/O errors, exit 4.
     cmd(&["render", "no_such_scene.xml", "-o", "OUT"], 4, "error: no_such_scene.xml: No such file or directory (os error 2)\n"),
     // Limits: --spp on the command line, the flag that lifts them, and the other commands.
-    cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "error: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
+    cmd(&["render", "no_objects.xml", "--spp", "100000", "-o", "OUT"], 3, "warning: no_objects.xml: the scene has no objects: every image shows only the background\nerror: --spp 100000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     cmd(&["render", "deep_recursion.xml", "--no-limits", "-o", "OUT"], 0, ""),
     // Structure parameters outside their range, or that do not apply: usage errors (exit 2), found
     // before the scene is read.
@@ -153,12 +164,15 @@ fn catalogue() -> Vec<Row> {
     cmd(&["bench", "sphere:100", "--accel", "octree", "--accel-param", "kdtree:depth=4"], 2, "error: --accel-param 'kdtree:depth=4': kdtree is not benchmarked (see --accel)\n"),
     cmd(&["bench", "sphere:100", "--accel-param", "depth=4"], 2, "error: --accel-param 'depth=4' is not KIND:KEY=VALUE\n"),
     // Merge: a part that is no partial EXR, or missing.
-    cmd(&["merge", "truncated.xml", "-o", "OUT"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
-    cmd(&["merge", "no_such_part.exr", "-o", "OUT"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
+    cmd(&["merge", "truncated.xml", "-o", "OUT/merged.png"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
+    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg\n"),
+    cmd(&["merge", "no_such_part.exr", "-o", "OUT/merged.png"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
     cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
-    // Mesh files given directly.
+    // Mesh files given directly: bench takes them, render and info say so.
+    cmd(&["render", "huge_count.ply", "-o", "OUT"], 3, "error: huge_count.ply: this is a mesh file, not a scene (.xml or .json); `arbor bench huge_count.ply` takes meshes\n"),
+    cmd(&["info", "inf.obj"], 3, "error: inf.obj: this is a mesh file, not a scene (.xml or .json); `arbor bench inf.obj` takes meshes\n"),
     cmd(&["bench", "huge_count.off"], 3, "error: huge_count.off:2: header claims 3000000000 vertices and 2000000000 faces but only 1 lines follow\n"),
     cmd(&["bench", "scene_as.ply"], 3, "error: scene_as.ply:1: not a PLY file (the first line must be `ply`)\n"),
     ]
@@ -166,7 +180,15 @@ fn catalogue() -> Vec<Row> {
 
 /// What went wrong with one row, if anything.
 fn run(row: &Row, dir: &Path, out: &Path) -> Result<(), String> {
-    let args: Vec<&str> = row.args.iter().map(|a| if *a == "OUT" { out.to_str().unwrap() } else { a }).collect();
+    let args: Vec<String> = row
+        .args
+        .iter()
+        .map(|a| match a.strip_prefix("OUT") {
+            Some(rest) => format!("{}{rest}", out.display()),
+            None => a.to_string(),
+        })
+        .collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let err_path = out.with_extension("stderr");
     let err_file = std::fs::File::create(&err_path).unwrap();
     let mut command = limited(&args);

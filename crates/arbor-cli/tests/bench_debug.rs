@@ -63,6 +63,15 @@ fn bench_bad_arguments_exit_with_clear_messages() {
     let o = arbor(&["bench", "sphere:100", "--accel-param", "octree:colour=red"], tmp.path());
     assert_eq!(o.status.code(), Some(2), "a parameter that does not apply is a usage error");
     assert!(stderr(&o).contains("octree has no parameter 'colour'"), "{}", stderr(&o));
+    // A misspelt ray set is a usage error listing the valid ones, not taken for a folder.
+    let o = arbor(&["bench", "sphere:100", "--rays", "primry"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("invalid value 'primry' for '--rays <RAYS>'")
+            && stderr(&o).contains("[possible values: primary, diffuse, both]"),
+        "{}",
+        stderr(&o)
+    );
     let o = arbor(&["bench", "sphere:lots"], tmp.path());
     assert_eq!(o.status.code(), Some(3));
     let o = arbor(&["bench", "nowhere.ply"], tmp.path());
@@ -115,7 +124,7 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
         std::fs::write(dir.join(format!("{set}.rays")), &bytes).unwrap();
         std::fs::write(dir.join(format!("{set}.hits")), &hits).unwrap();
     }
-    let o = arbor(&["bench", "quad.off", "--rays", "rays", "--threads", "1", "--runs", "1"], tmp.path());
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--threads", "1", "--runs", "1"], tmp.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("peer=")).collect();
@@ -130,12 +139,21 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
         assert!(line.contains("mismatch=0.333333"), "{line}");
     }
 
+    // --rays picks the sets of the folder: the primary files are not even read.
+    std::fs::write(dir.join("primary.rays"), b"").unwrap();
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--rays", "diffuse", "--runs", "1"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sets: Vec<String> = stdout(&o).lines().filter(|l| l.starts_with("peer=")).map(|l| l.to_string()).collect();
+    assert_eq!(sets.len(), 2, "{sets:?}");
+    assert!(sets.iter().all(|l| l.contains(" set=diffuse ")), "{sets:?}");
+    std::fs::write(dir.join("primary.rays"), &bytes).unwrap();
+
     // A truncated ray file is bad input (exit 3) named with its byte offset; a missing one an I/O error.
     std::fs::write(dir.join("diffuse.rays"), &bytes[..40]).unwrap();
-    let o = arbor(&["bench", "quad.off", "--rays", "rays", "--runs", "1"], tmp.path());
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--runs", "1"], tmp.path());
     assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
     assert!(stderr(&o).contains("diffuse.rays") && stderr(&o).contains("byte 32"), "{}", stderr(&o));
-    let o = arbor(&["bench", "quad.off", "--rays", "nowhere", "--runs", "1"], tmp.path());
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "nowhere", "--runs", "1"], tmp.path());
     assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     assert!(stderr(&o).contains("primary.rays"), "{}", stderr(&o));
 }

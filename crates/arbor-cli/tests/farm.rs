@@ -148,8 +148,9 @@ fn farm_cli_stats_json_and_plain_progress_lines() {
     let o = arbor(&["render", "two.xml", "--camera", "side", "--stats-json", "stats.json", "-o", "out"], d);
     assert!(o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
-    // Standard error is a pipe here: one plain line per tenth, ending at 100%.
-    assert!(err.lines().any(|l| l.starts_with("side.png: 100% (899/899 pixels, ")), "{err}");
+    // Standard error is a pipe here: plain progress lines, but none for a render shorter than their
+    // interval (tests/hardening.rs and the progress unit test cover the lines themselves).
+    assert!(!err.contains("side.png: "), "{err}");
     assert!(String::from_utf8_lossy(&o.stdout).ends_with("Saved: out/side.png\n"));
     let stats: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("stats.json")).unwrap()).unwrap();

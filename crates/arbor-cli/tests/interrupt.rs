@@ -22,7 +22,8 @@ fn start_long_render(out: &Path) -> Child {
         .unwrap()
 }
 
-/// Sends `signal` (a `kill` name) after `delay`; returns the exit code, failing after 60 s.
+/// Sends `signal` (a `kill` name) after `delay`; returns the exit code, failing unless the process
+/// stopped within a second.
 fn signal_and_wait(mut child: Child, signal: &str, delay: Duration) -> Option<i32> {
     std::thread::sleep(delay);
     let sent = Command::new("kill").arg(format!("-{signal}")).arg(child.id().to_string()).status().unwrap();
@@ -30,6 +31,11 @@ fn signal_and_wait(mut child: Child, signal: &str, delay: Duration) -> Option<i3
     let start = Instant::now();
     loop {
         if let Some(status) = child.try_wait().unwrap() {
+            assert!(start.elapsed() < Duration::from_secs(1), "stopped {:?} after SIG{signal}", start.elapsed());
+            let mut err = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+            let said = "interrupted: an image whose render was stopped is not written\n";
+            assert_eq!(err, said, "SIG{signal} must be reported once");
             return status.code();
         }
         if start.elapsed() > Duration::from_secs(60) {

@@ -15,6 +15,7 @@ pub mod error;
 pub mod farm;
 pub mod film;
 pub mod image_io;
+pub mod input;
 pub mod integrator;
 pub mod light;
 pub mod material;

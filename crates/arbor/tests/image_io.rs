@@ -123,7 +123,7 @@ fn write_unknown_extension_names_it_and_keeps_old_file() {
     fs::write(&path, b"old contents").unwrap();
     let err = write_image(&path, &level_film(2, 2)).unwrap_err().to_string();
     assert!(err.contains("\".bmp\""), "{err}");
-    assert!(err.contains("png, ppm, exr"), "{err}");
+    assert!(err.contains("png, ppm, exr, jpg, jpeg"), "{err}");
     assert_eq!(fs::read(&path).unwrap(), b"old contents");
     assert_eq!(strays(dir.path(), &["out.bmp"]), Vec::<String>::new());
 
@@ -325,4 +325,40 @@ fn read_jpeg_and_radiance_hdr() {
     let want = Color::new(4.0, 0.5, 100.0);
     // RGBE keeps 8 mantissa bits shared by the three channels.
     assert!(((film.get(1, 1) - want) / want).abs().max_element() < 0.01, "{}", film.get(1, 1));
+}
+
+#[test]
+fn jpeg_write_is_8_bit_and_close_to_the_film() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut film = Film::new(16, 8);
+    for (i, p) in film.pixels.iter_mut().enumerate() {
+        *p = if i % 16 < 8 { Color::new(0.8, 0.2, 0.1) } else { Color::new(0.1, 0.3, 0.9) };
+    }
+    for name in ["out.jpg", "out.JPEG"] {
+        let path = dir.path().join(name);
+        write_image(&path, &film).unwrap();
+        assert!(fs::read(&path).unwrap().starts_with(&[0xff, 0xd8, 0xff]), "{name} is not a JPEG");
+        let (w, h, rgb) = read_rgb8(&path).unwrap();
+        assert_eq!((w, h), (16, 8));
+        let want = film.to_rgb8();
+        let max = rgb.iter().zip(&want).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+        assert!(max <= 24, "{name}: a channel is off by {max} levels");
+    }
+}
+
+#[test]
+fn write_into_a_read_only_folder_names_the_target_not_the_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let locked = dir.path().join("locked");
+    fs::create_dir(&locked).unwrap();
+    let mut perms = fs::metadata(&locked).unwrap().permissions();
+    perms.set_readonly(true);
+    fs::set_permissions(&locked, perms).unwrap();
+    // Root ignores permission bits: then a folder no one may create files in stands in.
+    let folder = if fs::write(locked.join("probe"), b"").is_ok() { Path::new("/sys").to_path_buf() } else { locked };
+    let target = folder.join("out.png");
+    let err = write_image(&target, &level_film(2, 2)).unwrap_err();
+    assert!(err.is_io(), "{err}");
+    let msg = err.to_string();
+    assert!(msg.starts_with(&format!("{}: ", target.display())) && !msg.contains(".tmp"), "{msg}");
 }

@@ -61,8 +61,8 @@ pub struct RaySetFile {
 pub fn load_ray_set(dir: &Path, name: &str) -> Result<RaySetFile> {
     let rays_path = dir.join(format!("{name}.rays"));
     let hits_path = dir.join(format!("{name}.hits"));
-    let rays_bytes = std::fs::read(&rays_path).map_err(|e| Error::io(&rays_path, e))?;
-    let hits_bytes = std::fs::read(&hits_path).map_err(|e| Error::io(&hits_path, e))?;
+    let rays_bytes = crate::input::load_bytes(&rays_path)?;
+    let hits_bytes = crate::input::load_bytes(&hits_path)?;
     let rays = parse_rays(&rays_bytes, &rays_path)?;
     let hits = parse_hits(&hits_bytes, &hits_path)?;
     if rays.len() != hits.len() {

@@ -1,12 +1,16 @@
 //! Reading images into films (display units) or into exact 8-bit RGB.
 //!
-//! The format is recognised by the file's first bytes, then by its extension. Integer samples are divided
+//! The format is recognised by the file's first bytes, then by its extension. Files are read whole by
+//! [`crate::input::load_bytes`] (regular files only, never more than their length when opened) before
+//! they are decoded. Integer samples are divided
 //! by their maximum (255 or 65535), float samples (EXR, HDR) are kept as they are; grey is expanded to RGB
 //! and alpha is dropped, never composited, because references are compared as stored.
 
 use std::path::Path;
 
-use image::{DynamicImage, ImageReader};
+use std::io::Cursor;
+
+use image::{DynamicImage, ImageFormat, ImageReader};
 
 use crate::error::{Error, Location, Result};
 use crate::film::Film;
@@ -29,7 +33,11 @@ pub fn read_rgb8(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 }
 
 fn decode(path: &Path) -> Result<DynamicImage> {
-    let reader = ImageReader::open(path).and_then(|r| r.with_guessed_format()).map_err(|e| Error::io(path, e))?;
+    let mut reader = ImageReader::new(Cursor::new(crate::input::load_bytes(path)?));
+    if let Ok(format) = ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    let reader = reader.with_guessed_format().map_err(|e| Error::io(path, e))?;
     reader.decode().map_err(|e| match e {
         image::ImageError::IoError(io) => Error::io(path, io),
         other => Error::input(Location::file(path), format!("cannot decode image: {other}")),

@@ -3,13 +3,15 @@
 //! The encoded image is built in memory first (an encoder failure never touches the disk), then written to
 //! `.<name>.<pid>.<n>.tmp` next to the target, flushed to disk and renamed over the target. A rename within
 //! one directory is atomic on POSIX and replaces the target on Windows, so readers see either the old image
-//! or the new one. On any failure the temporary file is removed.
+//! or the new one. On any failure the temporary file is removed, and the error names the target (the
+//! temporary file is an implementation detail the user never asked for).
 
 use std::fs;
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use image::codecs::jpeg::JpegEncoder;
 use image::codecs::openexr::OpenExrEncoder;
 use image::codecs::png::PngEncoder;
 use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
@@ -19,17 +21,22 @@ use crate::error::{Error, Result};
 use crate::film::Film;
 
 /// The extensions [`write_image`] understands (compared case-insensitively).
-pub const SUPPORTED_WRITE_EXTENSIONS: &[&str] = &["png", "ppm", "exr"];
+pub const SUPPORTED_WRITE_EXTENSIONS: &[&str] = &["png", "ppm", "exr", "jpg", "jpeg"];
+
+/// JPEG quality (of 100): high enough that the 8-bit quantisation, not the compression, dominates.
+const JPEG_QUALITY: u8 = 95;
 
 #[derive(Clone, Copy)]
 enum Format {
     Png,
     Ppm,
     Exr,
+    Jpeg,
 }
 
 /// Writes `film` to `path`, choosing the format by the extension (case-insensitive): `png` (8-bit RGB),
-/// `ppm` (binary P6, 8-bit) or `exr` (32-bit float RGB, values as they are, including > 1 and < 0).
+/// `ppm` (binary P6, 8-bit), `jpg`/`jpeg` (8-bit, quality 95, from the same 8-bit values as PNG) or
+/// `exr` (32-bit float RGB, values as they are, including > 1 and < 0).
 ///
 /// The parent directory is created when missing. The write is atomic: on failure an existing file at
 /// `path` is left untouched and no temporary file remains.
@@ -55,6 +62,7 @@ fn format_of(path: &Path) -> Result<Format> {
         Some("png") => Ok(Format::Png),
         Some("ppm") => Ok(Format::Ppm),
         Some("exr") => Ok(Format::Exr),
+        Some("jpg" | "jpeg") => Ok(Format::Jpeg),
         other => {
             let named = match other {
                 Some(e) => format!("unknown image extension \".{e}\""),
@@ -80,6 +88,12 @@ fn encode(film: &Film, format: Format) -> image::ImageResult<Vec<u8>> {
             h,
             ExtendedColorType::Rgb8,
         )?,
+        Format::Jpeg => JpegEncoder::new_with_quality(&mut out, JPEG_QUALITY).write_image(
+            &film.to_rgb8(),
+            w,
+            h,
+            ExtendedColorType::Rgb8,
+        )?,
         Format::Exr => {
             let bytes: Vec<u8> = film.pixels.iter().flat_map(|c| c.to_array()).flat_map(f32::to_ne_bytes).collect();
             OpenExrEncoder::new(&mut out).write_image(&bytes, w, h, ExtendedColorType::Rgb32F)?
@@ -96,7 +110,7 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     };
     fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let (tmp, mut file) = create_temp(&dir, path)?;
-    let written = file.write_all(bytes).and_then(|()| file.sync_all()).map_err(|e| Error::io(&tmp, e));
+    let written = file.write_all(bytes).and_then(|()| file.sync_all()).map_err(|e| Error::io(path, e));
     drop(file);
     let renamed = written.and_then(|()| fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
     if renamed.is_err() {
@@ -117,7 +131,7 @@ fn create_temp(dir: &Path, target: &Path) -> Result<(PathBuf, fs::File)> {
             Ok(f) => return Ok((tmp, f)),
             // A leftover from a killed run with the same pid: take the next number.
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(Error::io(&tmp, e)),
+            Err(e) => return Err(Error::io(target, e)),
         }
     }
 }

@@ -1,8 +1,9 @@
 //! Mesh file readers: bytes -> [`TriangleMesh`] or an error located in the file.
 //!
 //! Three formats, one reader each: PLY ([`parse_ply`]: ASCII and both binary byte orders), Wavefront OBJ
-//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a file (mapped into memory when it is a
-//! regular file) and picks the reader by extension.
+//! ([`parse_obj`]) and OFF ([`parse_off`]). [`load_mesh`] reads a regular file whole
+//! ([`crate::input::load_bytes`]: never mapped, so a file truncated meanwhile is an error, not a SIGBUS)
+//! and picks the reader by extension.
 //!
 //! Every reader validates what the renderer relies on, so that later stages never see bad data: every
 //! index is in range, every coordinate is finite, polygons are fan-triangulated (`v0 v1 v2 v3` ->
@@ -47,30 +48,20 @@ pub fn load_mesh(path: &Path) -> Result<TriangleMesh> {
             return Err(Error::input(Location::file(path), msg));
         }
     };
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    match map_file(&file) {
-        Some(map) => parse(&map, path),
-        None => {
-            let mut bytes = Vec::new();
-            std::io::Read::read_to_end(&mut &file, &mut bytes).map_err(|e| Error::io(path, e))?;
-            parse(&bytes, path)
-        }
-    }
+    parse(&crate::input::load_bytes(path)?, path)
 }
 
-/// The file's bytes mapped into memory, or `None` when it cannot be (empty, not a regular file, or
-/// the system declines): meshes are read once, front to back, and a mapping reads them straight from
-/// the page cache, where `read` would first copy them into a fresh buffer (the copy and the buffer's
-/// page faults were two thirds of loading a 19 MB binary PLY).
-fn map_file(file: &std::fs::File) -> Option<memmap2::Mmap> {
-    let meta = file.metadata().ok()?;
-    if !meta.is_file() || meta.len() == 0 {
-        return None;
+/// An empty vector with room for `n` items of a mesh read from `path`, or an I/O error saying that memory
+/// ran out (the CLI's exit 4) instead of an abort: headers are checked against the file's size, but a
+/// large file can still claim more than the machine has.
+pub(crate) fn vec_for<T>(n: u64, what: &str, path: &Path) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    if usize::try_from(n).ok().and_then(|n| v.try_reserve_exact(n).ok()).is_none() {
+        let gib = n as f64 * std::mem::size_of::<T>() as f64 / (1u64 << 30) as f64;
+        let msg = format!("not enough memory for {n} {what} ({gib:.1} GiB)");
+        return Err(Error::io(path, std::io::Error::new(std::io::ErrorKind::OutOfMemory, msg)));
     }
-    // SAFETY: the mapping is read-only and lives only while this file is parsed. Another process
-    // truncating or rewriting the file meanwhile could change the bytes under the parser (or fault);
-    // a mesh file being loaded is not expected to change, as for any program that maps its inputs.
-    unsafe { memmap2::MmapOptions::new().populate().map(file) }.ok()
+    Ok(v)
 }
 
 /// Lines of a text file as `(1-based line number, bytes without "\n" or "\r\n")`.
@@ -247,22 +238,20 @@ mod tests {
     }
 
     #[test]
-    fn load_mesh_maps_regular_files_and_reads_the_rest() {
+    fn load_mesh_reads_regular_files_only() {
         let dir = tempfile::tempdir().unwrap();
         let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
                     element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
         let path = dir.path().join("tri.ply");
         std::fs::write(&path, text).unwrap();
-        let file = std::fs::File::open(&path).unwrap();
-        assert!(map_file(&file).is_some(), "a regular file is mapped");
         assert_eq!(load_mesh(&path).unwrap(), parse_ply(text.as_bytes(), &path).unwrap());
         let empty = dir.path().join("empty.ply");
         std::fs::write(&empty, "").unwrap();
-        assert!(map_file(&std::fs::File::open(&empty).unwrap()).is_none(), "an empty file is read, not mapped");
         assert_eq!(load_mesh(&empty).unwrap_err().to_string(), parse_ply(b"", &empty).unwrap_err().to_string());
         let folder = dir.path().join("folder.ply");
         std::fs::create_dir(&folder).unwrap();
-        assert!(load_mesh(&folder).unwrap_err().to_string().contains("folder.ply"));
+        let e = load_mesh(&folder).unwrap_err();
+        assert_eq!(e.to_string(), format!("{}: not a regular file (a directory)", folder.display()));
     }
 
     #[test]

@@ -22,8 +22,8 @@ pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let mut r = Reader { path, lines: Lines::new(bytes, 1) };
     let (nv, nf) = r.header()?;
     let mut mesh = TriangleMesh {
-        positions: Vec::with_capacity(nv as usize),
-        indices: Vec::with_capacity(nf as usize),
+        positions: super::vec_for(nv, "vertices", path)?,
+        indices: super::vec_for(nf, "faces", path)?,
         ..Default::default()
     };
     for i in 0..nv {

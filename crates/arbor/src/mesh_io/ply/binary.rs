@@ -62,7 +62,7 @@ fn read_f64<E: Order>(ty: Ty, b: &[u8]) -> f64 {
 }
 
 #[inline]
-fn read_int<E: Order>(ty: Ty, b: &[u8]) -> i64 {
+pub(super) fn read_int<E: Order>(ty: Ty, b: &[u8]) -> i64 {
     match ty {
         Ty::I8 => i64::from(b[0] as i8),
         Ty::U8 => i64::from(b[0]),

@@ -19,6 +19,7 @@
 //! vertex or per face. The header and its size check are in `header.rs`.
 
 mod binary;
+mod counts;
 mod generic;
 mod header;
 
@@ -28,19 +29,31 @@ use self::generic::{read_element, Ascii};
 use self::header::{check_sizes, parse_header, Element, Format, Header, Kind, Property, Ty};
 use crate::geometry::TriangleMesh;
 use crate::math::{Vec2, Vec3};
+use crate::mesh_io::vec_for;
 use crate::{Error, Location, Result};
 
 /// Parses a PLY file already in memory; `path` is only used in error messages.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     let header = parse_header(bytes, path)?;
-    check_sizes(&header, bytes, path)?;
-    let (roles, nv) = plan_roles(&header, path)?;
+    parse_body(&header, bytes, path).map_err(|e| {
+        let named = match header.format {
+            Format::Ascii => counts::disagreeing_count(&header, bytes, path),
+            Format::Le => counts::disagreeing_count_binary::<binary::Le>(&header, bytes, path),
+            Format::Be => counts::disagreeing_count_binary::<binary::Be>(&header, bytes, path),
+        };
+        named.unwrap_or(e)
+    })
+}
+
+fn parse_body(header: &Header, bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
+    check_sizes(header, bytes, path)?;
+    let (roles, nv) = plan_roles(header, path)?;
     let faces: u64 = header.elements.iter().filter(|e| e.name == "face").map(|e| e.count).sum();
     let mut out = Out {
-        positions: Vec::with_capacity(nv as usize),
+        positions: vec_for(nv, "vertices", path)?,
         normals: Vec::new(),
         uvs: Vec::new(),
-        indices: Vec::with_capacity(faces as usize),
+        indices: vec_for(faces, "faces", path)?,
     };
     let plan = roles.iter().find_map(|r| match r {
         Role::Vertex(p) => Some(p),
@@ -48,10 +61,10 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
     });
     let (has_normals, has_uvs) = plan.map_or((false, false), |p| (p.normals, p.uvs));
     if has_normals {
-        out.normals.reserve(nv as usize);
+        out.normals = vec_for(nv, "vertex normals", path)?;
     }
     if has_uvs {
-        out.uvs.reserve(nv as usize);
+        out.uvs = vec_for(nv, "texture coordinates", path)?;
     }
     match header.format {
         Format::Ascii => {
@@ -60,8 +73,8 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
                 read_element(&mut src, e, role, nv, &mut out)?;
             }
         }
-        Format::Le => binary::read_binary::<binary::Le>(bytes, &header, &roles, path, nv, &mut out)?,
-        Format::Be => binary::read_binary::<binary::Be>(bytes, &header, &roles, path, nv, &mut out)?,
+        Format::Le => binary::read_binary::<binary::Le>(bytes, header, &roles, path, nv, &mut out)?,
+        Format::Be => binary::read_binary::<binary::Be>(bytes, header, &roles, path, nv, &mut out)?,
     }
     Ok(TriangleMesh {
         positions: out.positions,
@@ -500,6 +513,41 @@ property float y\nproperty float z\n";
             "m.ply:4:15: list count type must be an integer type, not `float`"
         );
         assert_eq!(err(b"ply\nformat ascii 1.0\nend_header\n"), "m.ply: no `vertex` element");
+    }
+
+    #[test]
+    fn ply_ascii_count_that_disagrees_with_the_data_is_named_at_its_header_line() {
+        let more = CUBE.replace("element vertex 8", "element vertex 9");
+        assert_eq!(
+            err(more.as_bytes()),
+            "m.ply:5: element `vertex` claims 9 entries but the data has 8 (then a line of another shape)"
+        );
+        let fewer = CUBE.replace("element vertex 8", "element vertex 7");
+        assert_eq!(
+            err(fewer.as_bytes()),
+            "m.ply:5: element `vertex` claims 7 entries but the data has 8 before the next element"
+        );
+    }
+
+    #[test]
+    fn ply_binary_count_that_disagrees_with_the_data_is_named_at_its_header_line() {
+        // Four vertices and two triangles, the header claiming one vertex more or less.
+        for (le, claim) in [(true, 5), (false, 3), (true, 3)] {
+            let header = format!(
+                "element vertex {claim}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face 2\nproperty list uchar int vertex_indices\n"
+            );
+            let mut w = W::new(le, &header);
+            for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                w.f32(x).f32(y).f32(0.0);
+            }
+            w.u8(3).i32(0).i32(1).i32(2).u8(3).i32(0).i32(2).i32(3);
+            let want = format!(
+                "m.ply:3: element `vertex` claims {claim} entries but the data holds 4 (then the elements after it \
+                 fill the file exactly)"
+            );
+            assert_eq!(err(&w.buf), want, "{} claim {claim}", if le { "le" } else { "be" });
+        }
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! `arbor bench MESH --rays DIR`: traces the rays the peers' harness dumped (`peerbench --dump-rays
+//! `arbor bench MESH --ray-dir DIR`: traces the rays the peers' harness dumped (`peerbench --dump-rays
 //! DIR`) with Arbor's structures over the same mesh, and prints one line per (structure, ray set) in
 //! peerbench's own format, so that one script can put Arbor and the peers side by side on identical rays.
 //!
@@ -20,14 +20,14 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use arbor::accel::{Accel, AccelConfig, Hit};
+use arbor::accel::{Accel, AccelKind, Hit};
 use arbor::bench::ray_files::{disagrees, load_ray_set, RaySetFile};
 use arbor::bench::sphere_mesh;
 use arbor::geometry::TriangleMesh;
 use arbor::math::Ray;
 use rayon::prelude::*;
 
-use crate::bench::BenchArgs;
+use super::args::{specs, BenchArgs};
 use crate::Failure;
 
 /// Rays per parallel work item (peerbench's chunk size).
@@ -38,10 +38,17 @@ const MIN_TIME: Duration = Duration::from_millis(300);
 const MIN_RUNS: usize = 3;
 const MAX_TIME: Duration = Duration::from_millis(2500);
 
-/// Runs `arbor bench MESH --rays DIR` for the structures of `kinds`.
-pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelConfig]) -> Result<(), Failure> {
-    crate::set_threads(args.threads)?;
-    let threads = args.threads.unwrap_or_else(rayon::current_num_threads).max(1);
+/// Runs `arbor bench MESH --ray-dir DIR`.
+pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), Failure> {
+    // `all` leaves out brute force here: it would take hours on a million rays.
+    let kinds = match &args.accel {
+        None => vec![AccelKind::BvhSah],
+        Some(a) if a.0 == AccelKind::ALL => a.0.iter().copied().filter(|&k| k != AccelKind::Brute).collect(),
+        Some(a) => a.0.clone(),
+    };
+    let kinds = specs(&kinds, &args.accel_params)?;
+    args.threads.apply()?;
+    let threads = args.threads.count().max(1);
     let path = Path::new(&args.input);
     let start = Instant::now();
     let mesh = arbor::mesh_io::load_mesh(path)?;
@@ -54,7 +61,11 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelConfig]) -> Result<(), Fa
         load.as_secs_f64() * 1e3,
         bytes as f64 / load.as_secs_f64().max(1e-9) / 1e6
     );
-    let sets = [load_ray_set(dir, "primary")?, load_ray_set(dir, "diffuse")?];
+    let sets: Vec<RaySetFile> = ["primary", "diffuse"]
+        .into_iter()
+        .filter(|name| args.rays.has(name))
+        .map(|name| load_ray_set(dir, name))
+        .collect::<Result<_, _>>()?;
     let batches: Vec<Batch> = sets
         .iter()
         .map(|s| Batch {
@@ -63,7 +74,7 @@ pub fn run(args: &BenchArgs, dir: &Path, kinds: &[AccelConfig]) -> Result<(), Fa
         })
         .collect();
     let warm_up = sphere_mesh(2000);
-    for spec in kinds {
+    for spec in &kinds {
         drop(spec.build_accel(&warm_up).map_err(|e| Failure::Usage(e.to_string()))?);
         let mut builds = Vec::new();
         let mut cpu_builds = Vec::new();

@@ -1,6 +1,6 @@
-//! `arbor bench`: builds every chosen structure over one scene or mesh, traces the same primary and
-//! diffuse rays with each, and prints one row per structure: build statistics, Mrays/s, speedup over
-//! brute force, and the number of hits that differ from the default structure's (which makes the
+//! `arbor bench INPUT`: builds every chosen structure over one scene or mesh, traces the same primary
+//! and diffuse rays with each, and prints one row per structure: build statistics, Mrays/s, speedup
+//! over brute force, and the number of hits that differ from the default structure's (which makes the
 //! benchmark a correctness check as well: any difference is an error, exit 3).
 //!
 //! Rays are generated once from the default structure (bvh-sah) and its hits ([`arbor::bench`]). Brute
@@ -9,13 +9,13 @@
 
 use std::path::{Path, PathBuf};
 
-use arbor::accel::{AccelConfig, AccelKind, AccelStats, ConfigError, Hit, KindParam};
+use arbor::accel::{AccelConfig, AccelKind, AccelStats, Hit};
 use arbor::bench::{diffuse_rays, framing_camera, mesh_scene, mismatches, primary_rays, sample, sphere_mesh, trace};
 use arbor::math::Ray;
 use arbor::scene::{Scene, SceneDesc};
-use clap::Args;
 use serde_json::json;
 
+use super::args::{specs, AccelList, BenchArgs};
 use crate::Failure;
 
 /// The structure every other one is compared with, and that generates the rays.
@@ -23,73 +23,6 @@ const REFERENCE: AccelKind = AccelKind::BvhSah;
 
 /// Triangle tests brute force may spend per ray set (sets the default sample size).
 const BRUTE_BUDGET: usize = 500_000_000;
-
-/// Arguments of `arbor bench`.
-#[derive(Args)]
-pub struct BenchArgs {
-    /// A scene file (.xml, .json; its first camera at its resolution), a mesh file (.ply, .obj, .off;
-    /// framed by a default camera from the +z side, 1024x1024), or `sphere:N`, a generated unit sphere
-    /// of about N triangles (e.g. sphere:1000000).
-    pub input: String,
-    /// Structures to compare: `all`, or a comma-separated list (brute,octree,kdtree,bvh-median,bvh-sah,
-    /// bvh-bottom-up) [default: all; with a ray directory: bvh-sah].
-    #[arg(long, value_parser = parse_accel_list)]
-    pub accel: Option<AccelList>,
-    /// A build parameter for one structure, KIND:KEY=VALUE (e.g. octree:leaf=16; repeatable).
-    #[arg(long = "accel-param", value_name = "KIND:KEY=VALUE")]
-    pub accel_params: Vec<String>,
-    /// Which ray sets to time: `primary`, `diffuse` or `both`; or a directory of ray files written by
-    /// `peerbench --dump-rays DIR` for the mesh INPUT, to trace exactly the peers' rays and print
-    /// peerbench's line format (see `docs/performance.md`).
-    #[arg(long, default_value = "both")]
-    pub rays: String,
-    /// Image size WxH, overriding the camera's resolution (the window stays: same view, fewer rays).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
-    pub size: Option<(u32, u32)>,
-    /// Timed passes over each ray set; the median is reported.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
-    pub runs: u32,
-    /// Rays per set traced by brute force (default: as many as 5e8 triangle tests allow, 64 to 4096).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-    pub brute_rays: Option<u64>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// One JSON document on standard output instead of the table.
-    #[arg(long)]
-    pub json: bool,
-    /// Lift the limits on image size and recursion depth (as `arbor render --no-limits`).
-    #[arg(long)]
-    pub no_limits: bool,
-}
-
-/// The structures named by `--accel`.
-#[derive(Clone)]
-pub struct AccelList(Vec<AccelKind>);
-
-fn parse_accel_list(s: &str) -> Result<AccelList, String> {
-    if s.trim() == "all" {
-        return Ok(AccelList(AccelKind::ALL.to_vec()));
-    }
-    let mut kinds: Vec<AccelKind> = Vec::new();
-    for name in s.split(',').map(str::trim) {
-        let kind: AccelKind = name.parse().map_err(|e: ConfigError| e.to_string())?;
-        if !kinds.contains(&kind) {
-            kinds.push(kind);
-        }
-    }
-    Ok(AccelList(kinds))
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("'{s}' is not WxH (e.g. 512x512)");
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
-    if w == 0 || h == 0 || w as u64 * h as u64 > 1 << 24 {
-        return Err(format!("image size {w}x{h} must be at least 1x1 and at most 16 M pixels"));
-    }
-    Ok((w, h))
-}
 
 /// One ray set as traced by the reference.
 struct RaySet {
@@ -106,20 +39,10 @@ struct SetResult {
     mismatches: usize,
 }
 
-/// Runs `arbor bench`.
-pub fn run(args: BenchArgs) -> Result<(), Failure> {
+/// Runs `arbor bench INPUT` without `--ray-dir`.
+pub fn run(args: &BenchArgs) -> Result<(), Failure> {
     let all = || AccelList(AccelKind::ALL.to_vec());
-    if !matches!(args.rays.as_str(), "primary" | "diffuse" | "both") {
-        // `all` leaves out brute force here: it would take hours on a million rays.
-        let kinds = match &args.accel {
-            None => vec![REFERENCE],
-            Some(a) if a.0 == AccelKind::ALL => a.0.iter().copied().filter(|&k| k != AccelKind::Brute).collect(),
-            Some(a) => a.0.clone(),
-        };
-        let specs = specs(&kinds, &args.accel_params)?;
-        return crate::bench_rays::run(&args, Path::new(&args.rays), &specs);
-    }
-    crate::set_threads(args.threads)?;
+    args.threads.apply()?;
     let specs = specs(&args.accel.clone().unwrap_or_else(all).0, &args.accel_params)?;
     let desc = load_input(&args.input, args.size)?;
     arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
@@ -132,8 +55,8 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     let diffuse = diffuse_rays(&reference, &primary, &primary_hits);
     let (diffuse_hits, _) = trace(&reference.geometry, &diffuse);
     let sets = [
-        RaySet { name: "primary", rays: primary, hits: primary_hits, timed: args.rays != "diffuse" },
-        RaySet { name: "diffuse", rays: diffuse, hits: diffuse_hits, timed: args.rays != "primary" },
+        RaySet { name: "primary", rays: primary, hits: primary_hits, timed: args.rays.has("primary") },
+        RaySet { name: "diffuse", rays: diffuse, hits: diffuse_hits, timed: args.rays.has("diffuse") },
     ];
     let prims = reference.geometry.counts.triangles + reference.geometry.counts.spheres;
     drop(reference);
@@ -161,9 +84,9 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
     }
     let total_mismatch: usize = rows.iter().flat_map(|(_, r)| r).map(|r| r.mismatches).sum();
     if args.json {
-        print_json(&args, prims, &sets, &brute, &rows);
+        print_json(args, prims, &sets, &brute, &rows);
     } else {
-        print_table(&args, prims, &sets, &brute, &rows);
+        print_table(args, prims, &sets, &brute, &rows);
     }
     if total_mismatch > 0 {
         return Err(arbor::Error::Invalid(format!(
@@ -172,24 +95,6 @@ pub fn run(args: BenchArgs) -> Result<(), Failure> {
         .into());
     }
     Ok(())
-}
-
-/// One configuration per structure, with the `--accel-param KIND:KEY=VALUE` entries of its kind; any
-/// entry that does not parse, names a structure not benchmarked, or does not apply is a usage error.
-fn specs(kinds: &[AccelKind], params: &[String]) -> Result<Vec<AccelConfig>, Failure> {
-    let mut configs: Vec<AccelConfig> = kinds.iter().map(|&k| AccelConfig::from(k)).collect();
-    for p in params {
-        let usage = |msg: String| Failure::Usage(msg);
-        let param: KindParam = p.parse().map_err(|e| match e {
-            ConfigError::NotKindKeyValue { .. } => usage(format!("--accel-param {e}")),
-            e => usage(format!("--accel-param '{p}': {e}")),
-        })?;
-        let config = configs.iter_mut().find(|c| c.kind() == param.kind);
-        let config = config
-            .ok_or_else(|| usage(format!("--accel-param '{p}': {} is not benchmarked (see --accel)", param.kind)))?;
-        config.set(&param.key, &param.value).map_err(|e| usage(format!("--accel-param '{p}': {e}")))?;
-    }
-    Ok(configs)
 }
 
 /// The scene to benchmark: a scene file, a mesh file under a default camera, or a generated sphere.

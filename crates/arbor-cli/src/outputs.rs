@@ -1,0 +1,134 @@
+//! Where `arbor render` writes, decided and checked before any rendering starts, so that a mistake in
+//! an output path costs seconds, not a finished render.
+//!
+//! `-o` names a folder (created if missing) into which every camera's image goes under the name the
+//! scene gives it, or, when it ends in an image extension, the one image of a scene with one camera (a
+//! scene with several is a usage error: `-o` then names a folder). Every target is checked: an
+//! extension Arbor writes, a folder that exists (images and partial EXRs may also name one that can be
+//! created, as their writers create it; `--stats-json` may not) and that accepts a new file (a probe file is created and removed at once, which also answers for root, for
+//! whom permission bits say nothing). Errors name the target file.
+
+use std::path::{Path, PathBuf};
+
+use arbor::image_io::SUPPORTED_WRITE_EXTENSIONS;
+use arbor::scene::CameraDesc;
+
+use crate::Failure;
+
+/// Extensions that make `-o` an image file rather than a folder: those Arbor writes, and common image
+/// formats it does not write (refused with the list of those it does, not taken as a folder name).
+const IMAGE_LIKE: &[&str] = &["png", "ppm", "exr", "jpg", "jpeg", "hdr", "tif", "tiff", "bmp", "gif", "webp", "tga"];
+
+fn ext_of(path: &Path) -> Option<String> {
+    path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase)
+}
+
+/// True when `-o` names an image file rather than a folder.
+pub fn names_a_file(out: &Path) -> bool {
+    ext_of(out).is_some_and(|e| IMAGE_LIKE.contains(&e.as_str()))
+}
+
+/// The image file of each camera of `cameras`, checked.
+pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>, Failure> {
+    if names_a_file(out) {
+        if cameras.len() != 1 {
+            return Err(Failure::Usage(format!(
+                "-o {} names one image, but the scene has {} cameras: -o names a folder for them (or pick one \
+                 with --camera ID)",
+                out.display(),
+                cameras.len()
+            )));
+        }
+        check_extension(out).map_err(Failure::Usage)?;
+        check_writable(out, true)?;
+        return Ok(vec![out.to_path_buf()]);
+    }
+    let mut targets = Vec::with_capacity(cameras.len());
+    for cam in cameras {
+        let path = out.join(&cam.image_name);
+        check_extension(&path).map_err(|msg| {
+            let msg = format!("Camera {}: ImageName '{}': {msg}", cam.id, cam.image_name);
+            arbor::Error::input(cam.loc.clone(), msg)
+        })?;
+        check_writable(&path, true)?;
+        targets.push(path);
+    }
+    Ok(targets)
+}
+
+/// An extension [`arbor::image_io::write_image`] writes.
+pub fn check_extension(path: &Path) -> Result<(), String> {
+    match ext_of(path) {
+        Some(e) if SUPPORTED_WRITE_EXTENSIONS.contains(&e.as_str()) => Ok(()),
+        Some(e) => Err(format!("cannot write .{e} images; supported: {}", SUPPORTED_WRITE_EXTENSIONS.join(", "))),
+        None => Err(format!("no image extension; supported: {}", SUPPORTED_WRITE_EXTENSIONS.join(", "))),
+    }
+}
+
+/// Checks that a new file can be created beside `path`. With `create`, missing folders are allowed when
+/// the nearest existing one accepts files (the write creates them); without, the folder must exist.
+pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
+    let fail = |why: String| Failure::Arbor(arbor::Error::io(path, std::io::Error::other(why)));
+    let mut dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !create && !dir.is_dir() {
+        return Err(fail(format!("cannot write it: the folder {} does not exist", dir.display())));
+    }
+    while !dir.exists() {
+        match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
+            _ => dir = PathBuf::from("."),
+        }
+    }
+    if !dir.is_dir() {
+        return Err(fail(format!("cannot write it: {} is not a folder", dir.display())));
+    }
+    let probe = dir.join(format!(".arbor-write-probe.{}.tmp", std::process::id()));
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(file) => {
+            drop(file);
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(fail(format!("cannot write it: {e}"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_o_is_a_file_only_with_an_image_extension() {
+        assert!(names_a_file(Path::new("out.jpg")) && names_a_file(Path::new("a/b.PNG")));
+        assert!(names_a_file(Path::new("out.tiff")), "refused later, not taken for a folder");
+        assert!(!names_a_file(Path::new("renders.v2")) && !names_a_file(Path::new("out")));
+    }
+
+    #[test]
+    fn outputs_extension_checked_against_the_writers() {
+        assert_eq!(check_extension(Path::new("a.jpeg")), Ok(()));
+        assert_eq!(
+            check_extension(Path::new("a.bmp")),
+            Err("cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg".into())
+        );
+    }
+
+    #[test]
+    fn outputs_missing_folder_is_an_error_unless_it_can_be_made() {
+        let tmp = tempfile::tempdir().unwrap();
+        let deep = tmp.path().join("a/b/img.png");
+        assert!(check_writable(&deep, true).is_ok());
+        assert!(!tmp.path().join("a").exists(), "checking creates nothing");
+        let Err(Failure::Arbor(e)) = check_writable(&deep, false) else { panic!("a missing folder passed") };
+        let want = format!(
+            "{}: cannot write it: the folder {} does not exist",
+            deep.display(),
+            deep.parent().unwrap().display()
+        );
+        assert_eq!(e.to_string(), want);
+        assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0, "the probe file is removed");
+    }
+}
