@@ -12,7 +12,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use image::codecs::jpeg::JpegEncoder;
-use image::codecs::openexr::OpenExrEncoder;
 use image::codecs::png::PngEncoder;
 use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
 use image::{ExtendedColorType, ImageEncoder};
@@ -28,9 +27,16 @@ const JPEG_QUALITY: u8 = 95;
 
 #[derive(Clone, Copy)]
 enum Format {
+    /// 8-bit RGB, through the image crate's encoders.
+    Rgb8(Rgb8),
+    /// 32-bit float RGB, through the exr crate.
+    Exr,
+}
+
+#[derive(Clone, Copy)]
+enum Rgb8 {
     Png,
     Ppm,
-    Exr,
     Jpeg,
 }
 
@@ -59,10 +65,10 @@ pub fn write_image(path: &Path, film: &Film) -> Result<()> {
 fn format_of(path: &Path) -> Result<Format> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("png") => Ok(Format::Png),
-        Some("ppm") => Ok(Format::Ppm),
+        Some("png") => Ok(Format::Rgb8(Rgb8::Png)),
+        Some("ppm") => Ok(Format::Rgb8(Rgb8::Ppm)),
         Some("exr") => Ok(Format::Exr),
-        Some("jpg" | "jpeg") => Ok(Format::Jpeg),
+        Some("jpg" | "jpeg") => Ok(Format::Rgb8(Rgb8::Jpeg)),
         other => {
             let named = match other {
                 Some(e) => format!("unknown image extension \".{e}\""),
@@ -77,27 +83,43 @@ fn format_of(path: &Path) -> Result<Format> {
     }
 }
 
-fn encode(film: &Film, format: Format) -> image::ImageResult<Vec<u8>> {
+fn encode(film: &Film, format: Format) -> std::result::Result<Vec<u8>, String> {
+    match format {
+        Format::Exr => encode_exr(film).map_err(|e| e.to_string()),
+        Format::Rgb8(f) => encode_rgb8(film, f).map_err(|e| e.to_string()),
+    }
+}
+
+/// 32-bit float RGB through the exr crate, the writer of the farm's partial EXRs too.
+fn encode_exr(film: &Film) -> exr::error::Result<Vec<u8>> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let w = film.width as usize;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let c = film.pixels[p.y() * w + p.x()];
+        (c.x, c.y, c.z)
+    });
+    let mut out = Cursor::new(Vec::new());
+    Image::from_channels((w, film.height as usize), channels).write().to_buffered(&mut out)?;
+    Ok(out.into_inner())
+}
+
+fn encode_rgb8(film: &Film, format: Rgb8) -> image::ImageResult<Vec<u8>> {
     let (w, h) = (film.width, film.height);
     let mut out = Cursor::new(Vec::new());
     match format {
-        Format::Png => PngEncoder::new(&mut out).write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?,
-        Format::Ppm => PnmEncoder::new(&mut out).with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary)).write_image(
+        Rgb8::Png => PngEncoder::new(&mut out).write_image(&film.to_rgb8(), w, h, ExtendedColorType::Rgb8)?,
+        Rgb8::Ppm => PnmEncoder::new(&mut out).with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary)).write_image(
             &film.to_rgb8(),
             w,
             h,
             ExtendedColorType::Rgb8,
         )?,
-        Format::Jpeg => JpegEncoder::new_with_quality(&mut out, JPEG_QUALITY).write_image(
+        Rgb8::Jpeg => JpegEncoder::new_with_quality(&mut out, JPEG_QUALITY).write_image(
             &film.to_rgb8(),
             w,
             h,
             ExtendedColorType::Rgb8,
         )?,
-        Format::Exr => {
-            let bytes: Vec<u8> = film.pixels.iter().flat_map(|c| c.to_array()).flat_map(f32::to_ne_bytes).collect();
-            OpenExrEncoder::new(&mut out).write_image(&bytes, w, h, ExtendedColorType::Rgb32F)?
-        }
     }
     Ok(out.into_inner())
 }
