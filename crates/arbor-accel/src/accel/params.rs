@@ -40,11 +40,11 @@ impl ParamRange {
     /// Whether `v` is a value of this range.
     pub fn contains(&self, v: &ParamValue) -> bool {
         match (*self, v) {
-            (ParamRange::Int { min, max }, ParamValue::Int(x)) => *x >= min && max.map_or(true, |m| *x <= m),
+            (ParamRange::Int { min, max }, ParamValue::Int(x)) => *x >= min && max.is_none_or(|m| *x <= m),
             (ParamRange::IntOrAuto { .. }, ParamValue::Auto) => true,
             (ParamRange::IntOrAuto { min, max }, ParamValue::Int(x)) => (min..=max).contains(x),
             (ParamRange::Float { min, max }, ParamValue::Float(x)) => {
-                x.is_finite() && *x >= min && max.map_or(true, |m| *x <= m)
+                x.is_finite() && *x >= min && max.is_none_or(|m| *x <= m)
             }
             (ParamRange::Choice(words), ParamValue::Word(w)) => words.contains(w),
             _ => false,

@@ -217,8 +217,9 @@ fn median(xs: &mut [f64]) -> f64 {
 
 /// CPU time of the whole process so far (user and system, every thread).
 fn cpu_time() -> Duration {
-    // SAFETY: `getrusage` only writes the struct it is given, which is plain old data.
+    // SAFETY: `rusage` is plain old data (integers and `timeval`s), for which all zero bytes are valid.
     let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `getrusage` only writes the struct it is given, which lives for the whole call.
     if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
         return Duration::ZERO;
     }
