@@ -6,6 +6,7 @@
 
 mod build;
 pub mod desc;
+mod geometry;
 mod json;
 mod limits;
 mod metu;
@@ -16,10 +17,9 @@ mod xml;
 
 use std::path::Path;
 
-pub use build::{
-    build_geometry, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape, SWEEP_OBJECTS,
-};
+pub use build::build_geometry;
 pub use desc::*;
+pub use geometry::{MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape, SWEEP_OBJECTS};
 pub use limits::{check_limits, SceneLimits};
 pub use runtime::{Scene, Surface};
 

@@ -4,8 +4,9 @@
 
 use std::time::{Duration, Instant};
 
-use super::build::{build_geometry, SceneGeometry, Shape};
+use super::build::build_geometry;
 use super::desc::{MaterialDesc, OffsetRule, SceneDesc};
+use super::geometry::{SceneGeometry, Shape};
 use crate::accel::{AccelSpec, Hit};
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
