@@ -220,7 +220,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
         cancel: Some(Arc::clone(&signals.cancel)),
     };
     if let Some((_, _, x1, y1)) = args.crop {
-        if let Some(cam) = cameras.iter().map(|&c| &scene.desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
+        if let Some(cam) = cameras.iter().map(|&c| &scene.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
             return Err(arbor::Error::Invalid(format!(
                 "--crop reaches pixel ({x1}, {y1}) but camera '{}' is {}x{}",
                 cam.id, cam.width, cam.height
@@ -230,7 +230,7 @@ pub fn run(args: RenderArgs) -> Result<(), Failure> {
     }
     let mut records = Vec::new();
     for &c in &cameras {
-        let cam = &scene.desc.cameras[c];
+        let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         let (path, stats, window) = match &slice {
             Some(s) => {

@@ -1,7 +1,9 @@
-//! The build step for geometry: loads the mesh files of a description (each distinct file once, in
-//! parallel), gives every mesh object its own acceleration structure (in parallel), resolves instances
-//! to the mesh they show, and puts the objects under one top-level structure ([`super::geometry`]).
-//! Asset errors name the scene element that asked for the file.
+//! The build step, the one way from a description to a runtime scene ([`Scene::build`]): it loads the
+//! assets (mesh files, each distinct file once and in parallel; the environment map), gives every mesh
+//! object its own acceleration structure (in parallel), resolves instances to the mesh they show, puts
+//! the objects under one top-level structure ([`super::geometry`]), and turns the description's
+//! materials, lights and cameras into their runtime types. Asset errors name the scene element that
+//! asked for the file. Nothing after this step reads the description.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -10,11 +12,121 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
+use super::desc::{
+    CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule, SceneDesc, ShapeDesc,
+};
 use super::geometry::{prim_count, world_box, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
+use super::runtime::{RayOffset, Scene};
 use crate::accel::{self, AccelSpec, Primitives};
+use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
-use crate::{Error, Result};
+use crate::light::environment::EnvMap;
+use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
+use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
+use crate::{Error, Location, Result};
+
+impl Scene {
+    /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
+    /// both levels. `environment` overrides the scene's own map.
+    pub fn build(desc: SceneDesc, spec: &AccelSpec, environment: Option<EnvMap>) -> Result<Scene> {
+        let environment = match environment {
+            Some(env) => Some(env),
+            None => load_environment(&desc)?,
+        };
+        let start = Instant::now();
+        let geometry = build_geometry(&desc, spec)?;
+        let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
+        let offset = match desc.offset {
+            OffsetRule::ShadowEpsilon => RayOffset::ShadowEpsilon(desc.shadow_epsilon),
+            OffsetRule::ErrorBound => RayOffset::ErrorBound,
+        };
+        Ok(Scene {
+            geometry,
+            materials: desc.materials.iter().map(build_material).collect(),
+            object_materials: desc.objects.iter().map(|o| o.material).collect(),
+            lights: desc.lights.iter().map(build_light).collect(),
+            cameras: desc.cameras.iter().map(build_camera).collect(),
+            environment,
+            background: desc.background,
+            ambient: desc.ambient,
+            radiance_scale: desc.radiance_scale,
+            max_depth: desc.max_depth,
+            shadows: desc.shadows,
+            cull_backfaces: desc.cull_backfaces,
+            offset,
+            build_time,
+        })
+    }
+}
+
+/// The environment map the scene names, if any. A map that cannot be read is the scene's fault, like a
+/// missing mesh: located where the file names it.
+fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
+    let Some(path) = desc.environment.as_deref() else { return Ok(None) };
+    EnvMap::load(path).map(Some).map_err(|e| match e {
+        Error::Io { source, .. } => Error::input(
+            desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
+            format!("cannot read environment map '{}': {source}", path.display()),
+        ),
+        other => other,
+    })
+}
+
+/// The runtime camera of a description: its transform applied to position, gaze and up.
+pub fn build_camera(desc: &CameraDesc) -> Camera {
+    let t = &desc.transform;
+    let w = &desc.window;
+    let plane = ImagePlane { left: w.left, right: w.right, bottom: w.bottom, top: w.top, distance: desc.near_distance };
+    let projection = match desc.lens {
+        _ if desc.orthographic => Projection::Orthographic,
+        Some(l) => Projection::ThinLens { aperture: l.aperture, focus_distance: l.focus_distance },
+        None => Projection::Pinhole,
+    };
+    let mut camera = Camera::new(
+        t.point(desc.position),
+        t.vector(desc.gaze),
+        t.vector(desc.up),
+        plane,
+        projection,
+        desc.width,
+        desc.height,
+    );
+    camera.id = desc.id.clone();
+    camera.image_name = desc.image_name.clone();
+    camera.num_samples = desc.num_samples;
+    camera
+}
+
+/// The runtime material of a description.
+fn build_material(desc: &MaterialDesc) -> Material {
+    let layer: Option<Box<dyn SpecularLayer>> = match desc.kind {
+        MaterialKind::BlinnPhong => None,
+        MaterialKind::Mirror { reflectance } => Some(Box::new(Mirror { reflectance })),
+        MaterialKind::Conductor { reflectance, eta, k } => Some(Box::new(Conductor { reflectance, eta, k })),
+        MaterialKind::Dielectric { eta, absorption } => Some(Box::new(Dielectric { eta, absorption })),
+        MaterialKind::Transparent { eta, transparency, mirror } => {
+            Some(Box::new(Transparent { eta, transparency, mirror }))
+        }
+    };
+    Material {
+        ambient: desc.ambient,
+        diffuse: desc.diffuse,
+        specular: desc.specular,
+        phong_exponent: desc.phong_exponent,
+        layer,
+    }
+}
+
+/// The runtime light of a description.
+fn build_light(desc: &LightDesc) -> Box<dyn Light> {
+    match *desc {
+        LightDesc::Point { position, intensity } => Box::new(PointLight { position, intensity }),
+        LightDesc::Area { position, normal, size, radiance } => {
+            Box::new(AreaLight { position, normal, size, radiance })
+        }
+        LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+    }
+}
 
 /// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes, at both
 /// levels.
@@ -153,4 +265,99 @@ fn load_mesh_files(desc: &SceneDesc) -> Result<HashMap<PathBuf, Arc<TriangleMesh
             Ok(((*path).clone(), Arc::new(mesh)))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Color, Transform, Vec2, Vec3};
+    use crate::scene::desc::{Lens, Window};
+
+    fn camera_desc() -> CameraDesc {
+        CameraDesc {
+            id: "7".into(),
+            position: Vec3::new(0.0, 0.0, 20.0),
+            gaze: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::new(0.0, 1.0, 0.0),
+            window: Window { left: -10.0, right: 10.0, bottom: -10.0, top: 10.0 },
+            near_distance: 10.0,
+            orthographic: false,
+            width: 800,
+            height: 800,
+            image_name: "x.png".into(),
+            num_samples: 4,
+            transform: Transform::IDENTITY,
+            lens: None,
+            loc: Location::file("x.xml"),
+        }
+    }
+
+    #[test]
+    fn build_camera_keeps_image_and_applies_transform() {
+        let mut d = camera_desc();
+        d.transform = Transform::rotate(90.0, Vec3::Y).unwrap();
+        let cam = build_camera(&d);
+        assert_eq!((cam.id.as_str(), cam.image_name.as_str(), cam.num_samples), ("7", "x.png", 4));
+        assert_eq!((cam.width, cam.height), (800, 800));
+        let r = cam.ray(400, 400, Vec2::ZERO, Vec2::ZERO);
+        assert!(r.origin.abs_diff_eq(Vec3::new(20.0, 0.0, 0.0), 1e-4));
+        assert!(r.dir.abs_diff_eq(-Vec3::X, 1e-6));
+    }
+
+    #[test]
+    fn build_camera_picks_the_projection() {
+        let lens = Some(Lens { aperture: 2.0, focus_distance: 15.0 });
+        let thin = build_camera(&CameraDesc { lens, ..camera_desc() });
+        let a = thin.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9));
+        assert_ne!(a.origin, Vec3::new(0.0, 0.0, 20.0), "a thin lens starts rays off the eye");
+        // An orthographic camera ignores the lens: parallel rays along the gaze.
+        let ortho = build_camera(&CameraDesc { lens, orthographic: true, ..camera_desc() });
+        let o = ortho.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9));
+        assert_eq!(o.dir, -Vec3::Z);
+        let pinhole = build_camera(&camera_desc());
+        assert_eq!(pinhole.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9)).origin, Vec3::new(0.0, 0.0, 20.0));
+    }
+
+    #[test]
+    fn build_material_maps_every_kind() {
+        let desc = |kind| MaterialDesc {
+            id: "m".into(),
+            ambient: Color::splat(0.1),
+            diffuse: Color::splat(0.2),
+            specular: Color::splat(0.3),
+            phong_exponent: 5.0,
+            kind,
+        };
+        let plain = build_material(&desc(MaterialKind::BlinnPhong));
+        assert!(plain.layer.is_none() && !plain.transmits());
+        assert_eq!(
+            (plain.ambient, plain.diffuse, plain.specular, plain.phong_exponent),
+            (Color::splat(0.1), Color::splat(0.2), Color::splat(0.3), 5.0)
+        );
+        let glass = build_material(&desc(MaterialKind::Dielectric { eta: 1.5, absorption: Color::splat(0.25) }));
+        assert!(glass.transmits());
+        assert_eq!(glass.interior_absorption(), Some(Color::splat(0.25)));
+        let legacy =
+            build_material(&desc(MaterialKind::Transparent { eta: 1.5, transparency: Color::ONE, mirror: Color::ONE }));
+        assert!(legacy.transmits() && legacy.interior_absorption().is_none());
+        let d = Vec3::new(0.0, -1.0, 0.0);
+        assert_eq!(legacy.specular_lobes(d, Vec3::Y).len(), 3);
+        let mirror = build_material(&desc(MaterialKind::Mirror { reflectance: Color::ONE }));
+        assert_eq!(mirror.specular_lobes(d, Vec3::Y)[0].dir, Vec3::Y);
+        let metal = build_material(&desc(MaterialKind::Conductor { reflectance: Color::ONE, eta: 0.4, k: 2.8 }));
+        assert!(!metal.transmits() && metal.specular_lobes(d, Vec3::Y).len() == 1);
+    }
+
+    #[test]
+    fn build_light_maps_every_kind() {
+        let p = Vec3::new(0.0, 0.0, 0.0);
+        let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) });
+        assert_eq!(point.sample(p, Vec2::ZERO).unwrap().irradiance, Color::ONE);
+        let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) });
+        assert_eq!(dir.sample(p, Vec2::ZERO).unwrap().wi, Vec3::Y);
+        let area =
+            LightDesc::Area { position: Vec3::Y * 4.0, normal: -Vec3::Y, size: 0.5, radiance: Color::splat(64.0) };
+        let s = build_light(&area).sample(p, Vec2::splat(0.5)).unwrap();
+        assert!((s.irradiance.x - 64.0 * 0.25 / 16.0).abs() < 1e-5);
+    }
 }

@@ -1,5 +1,7 @@
-//! Scenes: the readers of each file format produce one [`SceneDesc`]; [`Scene::build`] turns it into
-//! world-space primitives under an acceleration structure.
+//! Scenes: the readers of each file format produce one [`SceneDesc`] (plain data with source
+//! positions); the build step ([`Scene::build`], in `build.rs`) loads its assets and turns it into a
+//! runtime [`Scene`]: geometry under acceleration structures (`geometry.rs`), materials, lights, cameras
+//! and the settings shading needs (`runtime.rs`). Nothing reads the description after the build.
 //!
 //! The METU XML and JSON forms share one reader: both are first turned into the same element tree
 //! ([`tree`]), and one interpreter ([`metu`]) reads the scene from that tree.
@@ -17,11 +19,11 @@ mod xml;
 
 use std::path::Path;
 
-pub use build::build_geometry;
+pub use build::{build_camera, build_geometry};
 pub use desc::*;
 pub use geometry::{MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape, SWEEP_OBJECTS};
 pub use limits::{check_limits, SceneLimits};
-pub use runtime::{Scene, Surface};
+pub use runtime::{RayOffset, Scene, Surface};
 
 use crate::{Error, Location, Result};
 
