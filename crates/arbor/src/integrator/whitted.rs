@@ -6,6 +6,9 @@
 //! Secondary ray origins are pushed off the surface to the side the new ray leaves from, so a ray never
 //! re-hits its own surface: by the scene's `ShadowRayEpsilon` or by the hit point's floating-point error
 //! bound ([`super::offset::spawn_origin`] decides).
+//!
+//! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
+//! lights their [`crate::light::Light::sample`], never the description.
 
 use super::offset::spawn_origin;
 use crate::accel::Hit;
