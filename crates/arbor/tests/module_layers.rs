@@ -227,11 +227,19 @@ fn expand_tree(prefix: &ModPath, tree: &str, out: &mut Vec<(ModPath, String)>) {
     out.push((full, name));
 }
 
-/// `use` declarations of `code`: (is `pub`, expanded paths, line).
-fn use_decls(code: &str) -> Vec<(bool, Vec<(ModPath, String)>, usize)> {
+/// One `use` declaration.
+struct UseDecl {
+    /// `pub use` (any visibility): a re-export.
+    public: bool,
+    /// The paths it names, each with the name it is known by.
+    paths: Vec<(ModPath, String)>,
+    line: usize,
+}
+
+/// `use` declarations of `code`.
+fn use_decls(code: &str) -> Vec<UseDecl> {
     let mut out = Vec::new();
-    let bytes: Vec<char> = code.chars().collect();
-    let text: String = bytes.iter().collect();
+    let text = code;
     let mut search = 0;
     while let Some(k) = text[search..].find("use ") {
         let at = search + k;
@@ -245,7 +253,7 @@ fn use_decls(code: &str) -> Vec<(bool, Vec<(ModPath, String)>, usize)> {
         let Some(end) = text[at..].find(';') else { break };
         let mut paths = Vec::new();
         expand_tree(&Vec::new(), &text[at + 4..at + end], &mut paths);
-        out.push((is_pub, paths, text[..at].matches('\n').count() + 1));
+        out.push(UseDecl { public: is_pub, paths, line: text[..at].matches('\n').count() + 1 });
     }
     out
 }
@@ -351,8 +359,8 @@ impl Crate {
         for k in 0..c.files.len() {
             let (module, code) = (c.files[k].module.clone(), c.files[k].code.clone());
             c.items.insert(module.clone(), public_items(&code));
-            for (is_pub, paths, _) in use_decls(&code) {
-                for (path, name) in paths.into_iter().filter(|_| is_pub) {
+            for decl in use_decls(&code).into_iter().filter(|d| d.public) {
+                for (path, name) in decl.paths {
                     // A re-export from another crate: marked so that resolving stops there.
                     let abs = c
                         .absolute(&c.files[k], &path)
@@ -428,8 +436,8 @@ impl Crate {
         let mut out = Vec::new();
         for f in &self.files {
             let mut refs: Vec<Ref> = Vec::new();
-            for (is_pub, paths, line) in use_decls(&f.code) {
-                refs.extend(paths.into_iter().filter(|_| !is_pub).map(|(path, _)| Ref { path, line }));
+            for decl in use_decls(&f.code).into_iter().filter(|d| !d.public) {
+                refs.extend(decl.paths.into_iter().map(|(path, _)| Ref { path, line: decl.line }));
             }
             refs.extend(
                 inline_paths(&without_uses(&f.code), &f.children).into_iter().map(|(path, line)| Ref { path, line }),
