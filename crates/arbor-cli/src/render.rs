@@ -210,7 +210,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     };
     let mut records = Vec::new();
     for (&c, target) in cameras.iter().zip(targets) {
-        let cam = &scene.desc.cameras[c];
+        let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         let (path, stats, window) = match &slice {
             Some(s) => {

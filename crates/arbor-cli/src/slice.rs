@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use arbor::scene::CameraDesc;
+use arbor::camera::Camera;
 use clap::Args;
 
 use crate::Failure;
@@ -78,7 +78,7 @@ impl Slice {
     }
 
     /// The window of `cam`'s frame this slice renders.
-    pub fn window(&self, cam: &CameraDesc) -> Result<Option<(u32, u32, u32, u32)>, Failure> {
+    pub fn window(&self, cam: &Camera) -> Result<Option<(u32, u32, u32, u32)>, Failure> {
         match self.tile {
             Some((i, n)) => arbor::farm::tile_window(i, n, cam.width, cam.height).map(Some).map_err(Failure::Usage),
             None => Ok(self.crop),

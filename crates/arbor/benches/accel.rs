@@ -39,7 +39,7 @@ fn inputs() -> (TriangleMesh, Vec<Ray>, Vec<Ray>) {
     let camera = framing_camera(mesh.bounds(), SIZE, SIZE);
     let desc = mesh_scene(mesh.clone(), Path::new("sphere"), camera);
     let scene = Scene::build(desc, &AccelConfig::default(), None).expect("the sphere scene builds");
-    let primary = primary_rays(&scene.desc.cameras[0]);
+    let primary = primary_rays(&scene.cameras[0]);
     let (hits, _) = trace(&scene.geometry, &primary);
     let diffuse = diffuse_rays(&scene, &primary, &hits);
     (mesh, primary, diffuse)

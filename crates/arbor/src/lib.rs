@@ -1,11 +1,14 @@
 //! Arbor: a Whitted ray tracer for triangle meshes, built around fast and exactly correct acceleration
 //! structures.
 //!
-//! Data flows one way: scene file -> [`scene::SceneDesc`] (format-neutral, with source positions) ->
-//! [`scene::Scene`] (world-space primitives + an acceleration structure) -> [`render`] (integrator per
-//! pixel, tiles over rayon, exact sample sums in [`accum`]) -> [`film::Film`] -> image file ([`image_io`]).
-//! On a farm, [`farm`] cuts a frame into tiles and sample ranges written as partial EXRs and merges them
-//! back into the same bits.
+//! Data flows one way, each step a layer that uses only the ones below it (docs/architecture.md):
+//! scene file -> readers ([`scene::load_desc`]) -> [`scene::SceneDesc`] (plain data with source
+//! positions) -> the build step ([`scene::Scene::build`]: loads meshes and environment maps, builds the
+//! acceleration structures) -> [`scene::Scene`] (runtime types only: [`scene::SceneGeometry`] over
+//! [`accel`], [`material::Material`], [`light::Light`], [`camera::Camera`]) -> [`integrator`] per pixel
+//! -> [`render`] (tiles over rayon, exact sample sums in [`accum`]) -> [`film::Film`] -> image file
+//! ([`image_io`]). Shading never reads the description. On a farm, [`farm`] cuts a frame into tiles and
+//! sample ranges written as partial EXRs and merges them back into the same bits.
 #![warn(missing_docs)]
 
 pub mod accum;

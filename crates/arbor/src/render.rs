@@ -25,7 +25,6 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use crate::accum::SampleSum;
-use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
 use crate::integrator::{DebugIntegrator, DebugView, Whitted};
@@ -88,8 +87,8 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> (Film, RenderStats) {
-    let desc = &scene.desc.cameras[camera];
-    let (w, h) = (desc.width, desc.height);
+    let cam = &scene.cameras[camera];
+    let (w, h) = (cam.width, cam.height);
     let (traced, stats, scale) = trace(scene, camera, opts, progress);
     let count = stats.samples.1 - stats.samples.0;
     // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
@@ -103,7 +102,7 @@ pub fn render(
     let heatmap_max = match opts.debug {
         Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
         Some(DebugView::Boxes { depth }) => {
-            overlay_boxes(&mut film, desc, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
+            overlay_boxes(&mut film, cam, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
             None
         }
         _ => None,
@@ -141,8 +140,8 @@ pub fn render_sums(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> (RenderSums, RenderStats) {
     let opts = RenderOptions { debug: None, ..opts.clone() };
-    let desc = &scene.desc.cameras[camera];
-    let window = crop_window(opts.crop, desc.width, desc.height);
+    let cam = &scene.cameras[camera];
+    let window = crop_window(opts.crop, cam.width, cam.height);
     let (traced, stats, scale) = trace(scene, camera, &opts, progress);
     let ww = (window.2 - window.0) as usize;
     let mut sums = vec![SampleSum::default(); ww * (window.3 - window.1) as usize];
@@ -152,7 +151,7 @@ pub fn render_sums(
             sums[y * ww + x] = s;
         }
     }
-    let frame = (desc.width, desc.height);
+    let frame = (cam.width, cam.height);
     (RenderSums { frame, window, spp: stats.spp, samples: stats.samples, scale, sums }, stats)
 }
 
@@ -166,13 +165,12 @@ fn trace(
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> (Traced, RenderStats, f32) {
     let start = Instant::now();
-    let desc = &scene.desc.cameras[camera];
-    let cam = Camera::new(desc);
-    let cull = opts.cull_backfaces.or(scene.desc.cull_backfaces).unwrap_or(false);
+    let cam = &scene.cameras[camera];
+    let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
     let integrator = Whitted::new(scene, cull);
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
     let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
-    let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(desc.num_samples).max(1) };
+    let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(cam.num_samples).max(1) };
     let (k0, k1) = match opts.samples {
         Some((k0, k1)) if debug.is_none() => (k0.min(spp - 1), k1.clamp(k0.min(spp - 1) + 1, spp)),
         _ => (0, spp),
@@ -188,7 +186,7 @@ fn trace(
     let is_cancelled = || opts.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed));
     let done = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
-    let scale = if debug.is_some() { 1.0 } else { scene.desc.radiance_scale };
+    let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
 
     let traced: Traced = tiles
         .par_iter()

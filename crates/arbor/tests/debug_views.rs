@@ -15,7 +15,7 @@ use arbor::integrator::debug::{false_color, legend_rows, overlay_boxes, BOX_COLO
 use arbor::integrator::DebugView;
 use arbor::math::{Aabb, Color, Vec3};
 use arbor::render::{render, RenderOptions};
-use arbor::scene::{load_desc, CameraDesc, Scene, SceneDesc, ShapeDesc, Window};
+use arbor::scene::{build_camera, load_desc, CameraDesc, Scene, SceneDesc, ShapeDesc, Window};
 
 /// Primitive tests (plus nodes) one structure may spend on one reference-scene image; beyond it (brute
 /// force on large scenes) only an evenly spaced sample of pixels is compared.
@@ -59,7 +59,7 @@ fn debug_primid_identical_across_structures_on_generated_mesh() {
 /// Estimated work of a primid render: the mean traversal cost of a sample of the camera's rays times
 /// the pixel count.
 fn estimated_work(scene: &Scene) -> f64 {
-    let rays = primary_rays(&scene.desc.cameras[0]);
+    let rays = primary_rays(&scene.cameras[0]);
     let step = (rays.len() / 64).max(1);
     let mut counts = TraversalCounts::default();
     let mut n = 0;
@@ -97,7 +97,7 @@ fn debug_primid_identical_across_structures_on_reference_scenes() {
                 // own camera ray only, so compare an evenly spaced sample of pixels, byte for byte.
                 let stride = (work / WORK_BUDGET).sqrt().ceil() as u32;
                 let cam = &desc.cameras[0];
-                let camera = arbor::camera::Camera::new(cam);
+                let camera = arbor::scene::build_camera(cam);
                 let integrator = arbor::integrator::DebugIntegrator::new(&scene, DebugView::PrimId, false);
                 let mut sampled = 0;
                 for y in (0..cam.height).step_by(stride as usize) {
@@ -204,6 +204,7 @@ fn debug_boxes_land_where_edges_project_and_nowhere_else() {
     let cam = straight_camera(5.0, 1.0, 100);
     let mut film = Film::new(100, 100);
     // The cube's front face (distance 4) spans pixels 37.5..62.5; its back face (distance 6) 41.7..58.3.
+    let cam = build_camera(&cam);
     overlay_boxes(&mut film, &cam, &[Aabb::new(Vec3::splat(-1.0), Vec3::ONE)], BOX_COLOR);
     for (x, y) in [(37, 50), (62, 50), (50, 37), (50, 62), (41, 50), (58, 50), (39, 39)] {
         assert_eq!(film.get(x, y), BOX_COLOR, "no edge at ({x}, {y})");

@@ -27,7 +27,7 @@ fn bits(film: &Film) -> Vec<u32> {
 
 /// Renders the slice, writes it as a partial EXR in `dir`, reads it back.
 fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)) -> (PathBuf, Partial) {
-    let cam = &scene.desc.cameras[0];
+    let cam = &scene.cameras[0];
     let crop = tile.map(|(i, n)| tile_window(i, n, cam.width, cam.height).unwrap());
     let opts = RenderOptions { crop, samples: Some(samples), ..Default::default() };
     let (sums, stats) = render_sums(scene, 0, &opts, &|_, _| {});

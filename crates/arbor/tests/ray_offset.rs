@@ -67,7 +67,7 @@ fn no_acne(name: &str, scene: &Scene, center: Vec3, distance: f32, rng: &mut Lcg
             if dir.dot(n) < 0.0 {
                 dir = -dir;
             }
-            let origin = spawn_origin(&scene.desc, &s, dir);
+            let origin = spawn_origin(scene.offset, &s, dir);
             let again = scene.geometry.intersect(&Ray::new(origin, dir), f32::INFINITY);
             assert!(again.is_none(), "{name}: acne at {:?} leaving along {dir:?}: {again:?}", s.p);
             assert!(!scene.geometry.occluded(&Ray::new(origin, dir), f32::INFINITY), "{name}: occluded");
@@ -151,7 +151,7 @@ fn leaks(rule: OffsetRule) -> usize {
         let ray = Ray::new(Vec3::new(x, 0.005 * x, z), -Vec3::Y);
         let hit = s.geometry.intersect(&ray, f32::INFINITY).expect("the floor");
         let surface = s.surface(&ray, &hit);
-        let origin = spawn_origin(&s.desc, &surface, Vec3::Y);
+        let origin = spawn_origin(s.offset, &surface, Vec3::Y);
         if !s.geometry.occluded(&Ray::new(origin, light - origin), 1.0) {
             leaked += 1;
         }

@@ -40,7 +40,7 @@ fn bits(film: &Film) -> Vec<u32> {
 fn compare_threads(name: &str, desc: SceneDesc, opts: &RenderOptions) -> Vec<String> {
     let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
     let mut differ = Vec::new();
-    for camera in 0..scene.desc.cameras.len() {
+    for camera in 0..scene.cameras.len() {
         for cull in [false, true] {
             let opts = RenderOptions { cull_backfaces: Some(cull), ..opts.clone() };
             let one = render_on(1, &scene, camera, &opts);

@@ -364,7 +364,7 @@ fn readers_shared_xml_and_json_twins_agree() {
         let what = rel.display();
         assert_eq!(dx.cameras, dj.cameras, "{what}");
         assert_eq!(dx.lights, dj.lights, "{what}");
-        // Two rules differ by form on purpose (see scene/metu.rs): an untyped material of a legacy XML
+        // Two rules differ by form on purpose (see scene/readers/metu.rs): an untyped material of a legacy XML
         // file (no material typed) takes its kind from its elements, while JSON keeps it Blinn-Phong;
         // and an absent MaxRecursionDepth is 0 in XML, 6 in JSON.
         let xml_text = std::fs::read_to_string(&x).unwrap();

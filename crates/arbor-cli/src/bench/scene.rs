@@ -50,7 +50,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Failure> {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", args.input)).into());
     }
     let reference = Scene::build(desc.clone(), &AccelConfig::from(REFERENCE), None)?;
-    let primary = primary_rays(&reference.desc.cameras[0]);
+    let primary = primary_rays(&reference.cameras[0]);
     let (primary_hits, _) = trace(&reference.geometry, &primary);
     let diffuse = diffuse_rays(&reference, &primary, &primary_hits);
     let (diffuse_hits, _) = trace(&reference.geometry, &diffuse);

@@ -113,9 +113,8 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
     desc
 }
 
-/// One ray through each pixel centre of `camera`, row by row from the top.
-pub fn primary_rays(camera: &CameraDesc) -> Vec<Ray> {
-    let cam = Camera::new(camera);
+/// One ray through each pixel centre of `cam`, row by row from the top.
+pub fn primary_rays(cam: &Camera) -> Vec<Ray> {
     let (w, h) = (cam.width, cam.height);
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
@@ -196,7 +195,7 @@ mod tests {
         let mesh = sphere_mesh(2000);
         let desc = mesh_scene(mesh.clone(), Path::new("sphere"), framing_camera(mesh.bounds(), 48, 32));
         let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap();
-        let rays = primary_rays(&scene.desc.cameras[0]);
+        let rays = primary_rays(&scene.cameras[0]);
         assert_eq!(rays.len(), 48 * 32);
         let (hits, _) = trace(&scene.geometry, &rays);
         // The border of the image misses; the centre hits.

@@ -18,9 +18,10 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::accel::TraversalCounts;
+use crate::camera::Camera;
 use crate::film::Film;
-use crate::math::{orthonormal_basis, Aabb, Color, Ray, Vec3};
-use crate::scene::{CameraDesc, Scene, Window};
+use crate::math::{Aabb, Color, Ray, Vec3};
+use crate::scene::Scene;
 
 /// Depth of the boxes drawn by `--debug boxes` without a depth.
 pub const DEFAULT_BOX_DEPTH: usize = 3;
@@ -172,79 +173,10 @@ pub fn heatmap_finish(film: &mut Film) -> u32 {
     max as u32
 }
 
-/// World to image projection with the frame [`crate::camera::Camera`] uses (lens ignored: boxes are
-/// drawn as the pinhole at the lens centre sees them).
-struct Projector {
-    eye: Vec3,
-    u: Vec3,
-    v: Vec3,
-    w: Vec3,
-    window: Window,
-    near: f32,
-    orthographic: bool,
-    width: f64,
-    height: f64,
-}
-
-impl Projector {
-    fn new(desc: &CameraDesc, width: u32, height: u32) -> Self {
-        let t = &desc.transform;
-        let w = -t.vector(desc.gaze).normalize_or(-Vec3::Z);
-        let u = t.vector(desc.up).cross(w).try_normalize().unwrap_or_else(|| orthonormal_basis(w).0);
-        Projector {
-            eye: t.point(desc.position),
-            u,
-            v: w.cross(u),
-            w,
-            window: desc.window,
-            near: desc.near_distance,
-            orthographic: desc.orthographic,
-            width: width as f64,
-            height: height as f64,
-        }
-    }
-
-    /// `(right, up, depth along the gaze)` of a world point.
-    fn to_camera(&self, p: Vec3) -> [f64; 3] {
-        let d = p - self.eye;
-        [d.dot(self.u) as f64, d.dot(self.v) as f64, -d.dot(self.w) as f64]
-    }
-
-    /// Continuous pixel coordinates (pixel `(x, y)` spans `[x, x+1) x [y, y+1)`) of a camera-space point
-    /// in front of the camera.
-    fn to_pixel(&self, [a, b, c]: [f64; 3]) -> [f64; 2] {
-        let (pu, pv) = if self.orthographic { (a, b) } else { (a * self.near as f64 / c, b * self.near as f64 / c) };
-        let wd = &self.window;
-        let x = (pu - wd.left as f64) / (wd.right - wd.left) as f64 * self.width;
-        let y = (wd.top as f64 - pv) / (wd.top - wd.bottom) as f64 * self.height;
-        [x, y]
-    }
-
-    /// The part of a camera-space segment in front of the camera, if any.
-    fn clip_depth(&self, mut p: [f64; 3], mut q: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
-        // Perspective projection divides by depth: keep a sliver in front of the eye.
-        let min = if self.orthographic { 0.0 } else { self.near as f64 * 1e-3 };
-        if p[2] < min && q[2] < min {
-            return None;
-        }
-        let cut = |a: [f64; 3], b: [f64; 3]| {
-            let s = (min - a[2]) / (b[2] - a[2]);
-            [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), min]
-        };
-        if p[2] < min {
-            p = cut(p, q);
-        } else if q[2] < min {
-            q = cut(q, p);
-        }
-        Some((p, q))
-    }
-}
-
-/// Draws the 12 edges of every box over `film` in `color`, as seen by camera `camera` (whose window
-/// and frame are used at the film's resolution). Edges are clipped to the part in front of the camera
-/// and to the image.
-pub fn overlay_boxes(film: &mut Film, camera: &CameraDesc, boxes: &[Aabb], color: Color) {
-    let proj = Projector::new(camera, film.width, film.height);
+/// Draws the 12 edges of every box over `film` in `color`, as seen by `camera` ([`Camera::project_segment`]:
+/// the pinhole at the lens centre, edges clipped to the part in front of it); `film` is the camera's
+/// full frame. Edges are clipped to the image.
+pub fn overlay_boxes(film: &mut Film, camera: &Camera, boxes: &[Aabb], color: Color) {
     for b in boxes.iter().filter(|b| !b.is_empty()) {
         let corner = |k: usize| {
             let pick = |bit: usize, lo: f32, hi: f32| if k & bit != 0 { hi } else { lo };
@@ -254,9 +186,8 @@ pub fn overlay_boxes(film: &mut Film, camera: &CameraDesc, boxes: &[Aabb], color
         for k in 0..8 {
             for bit in [1, 2, 4] {
                 if k & bit == 0 {
-                    let (p, q) = (proj.to_camera(corner(k)), proj.to_camera(corner(k | bit)));
-                    if let Some((p, q)) = proj.clip_depth(p, q) {
-                        draw_line(film, proj.to_pixel(p), proj.to_pixel(q), color);
+                    if let Some((p, q)) = camera.project_segment(corner(k), corner(k | bit)) {
+                        draw_line(film, p.to_array(), q.to_array(), color);
                     }
                 }
             }

@@ -6,14 +6,16 @@
 //! Secondary ray origins are pushed off the surface to the side the new ray leaves from, so a ray never
 //! re-hits its own surface: by the scene's `ShadowRayEpsilon` or by the hit point's floating-point error
 //! bound ([`super::offset::spawn_origin`] decides).
+//!
+//! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
+//! lights their [`crate::light::Light::sample`], never the description.
 
 use super::offset::spawn_origin;
 use crate::accel::Hit;
-use crate::light::sample_light;
-use crate::material::{beer, blinn_phong, specular_lobes};
+use crate::material::{beer, blinn_phong};
 use crate::math::{Color, Ray};
 use crate::sampler::Rng;
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::Scene;
 
 /// The integrator for one render.
 pub struct Whitted<'a> {
@@ -76,43 +78,43 @@ impl<'a> Whitted<'a> {
 
         // A refractive surface hit from inside only refracts and reflects: its ambient and Blinn-Phong
         // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
-        let local = front || !matches!(m.kind, MaterialKind::Dielectric { .. } | MaterialKind::Transparent { .. });
-        let mut color = if local { m.ambient * scene.desc.ambient } else { Color::ZERO };
+        let local = front || !m.transmits();
+        let mut color = if local { m.ambient * scene.ambient } else { Color::ZERO };
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
-        let shadow_origin = spawn_origin(&scene.desc, &s, ng);
-        for light in scene.desc.lights.iter().filter(|_| local) {
-            let Some(ls) = sample_light(light, s.p, rng.next_2d()) else { continue };
+        let shadow_origin = spawn_origin(scene.offset, &s, ng);
+        for light in scene.lights.iter().filter(|_| local) {
+            let Some(ls) = light.sample(s.p, rng.next_2d()) else { continue };
             if ns.dot(ls.wi) <= 0.0 {
                 continue;
             }
-            *count += scene.desc.shadows as u64;
+            *count += scene.shadows as u64;
             let shadow = if ls.dist.is_finite() {
                 Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
             } else {
                 Ray::new(shadow_origin, ls.wi)
             };
             let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
-            if scene.desc.shadows && scene.geometry.occluded(&shadow, t_max) {
+            if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
             color += blinn_phong(m, ns, ls.wi, -d) * ls.irradiance;
         }
 
-        if depth < scene.desc.max_depth && !matches!(m.kind, MaterialKind::BlinnPhong) {
+        if depth < scene.max_depth && m.layer.is_some() {
             // Lobes see the shading normal unless it disagrees with the geometric one about which side
             // the ray comes from (possible at silhouettes of smooth meshes).
             let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
-            for lobe in specular_lobes(&m.kind, d, n) {
+            for lobe in m.specular_lobes(d, n) {
                 if lobe.weight == Color::ZERO {
                     continue;
                 }
-                let origin = spawn_origin(&scene.desc, &s, lobe.dir);
+                let origin = spawn_origin(scene.offset, &s, lobe.dir);
                 // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
                 // a reflected one stays in whatever medium it was in.
-                let next_inside = match (lobe.transmitted, &m.kind) {
+                let next_inside = match (lobe.transmitted, front) {
                     (false, _) => inside,
-                    (true, MaterialKind::Dielectric { absorption, .. }) if front => Some(*absorption),
-                    (true, _) => None,
+                    (true, true) => m.interior_absorption(),
+                    (true, false) => None,
                 };
                 let l = self.li(&Ray::new(origin, lobe.dir), depth + 1, next_inside, rng, count);
                 color += lobe.weight * l;
@@ -129,10 +131,10 @@ impl<'a> Whitted<'a> {
     fn miss(&self, ray: &Ray, depth: u32) -> Color {
         let scene = self.scene;
         if let Some(env) = &scene.environment {
-            return env.eval(ray.dir) / scene.desc.radiance_scale;
+            return env.eval(ray.dir) / scene.radiance_scale;
         }
         if depth == 0 {
-            scene.desc.background
+            scene.background
         } else {
             Color::ZERO
         }

@@ -2,11 +2,31 @@
 //! emitting `radiance` from its front side. One point is sampled per shading sample; the solid angle is
 //! approximated as in the course notes, `A |n_l · w_i| / d²`, which is exact for small, distant lights.
 
-use super::LightSample;
+use super::{Light, LightSample};
 use crate::math::{orthonormal_basis, Color, Vec2, Vec3};
 
-/// The light of the point `u` (in `[0,1)²`) of the square light reaching `p`.
-pub fn sample_area(position: Vec3, normal: Vec3, size: f32, radiance: Color, p: Vec3, u: Vec2) -> Option<LightSample> {
+/// A square light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AreaLight {
+    /// Centre.
+    pub position: Vec3,
+    /// Facing direction (unit).
+    pub normal: Vec3,
+    /// Side length.
+    pub size: f32,
+    /// Emitted radiance.
+    pub radiance: Color,
+}
+
+impl Light for AreaLight {
+    /// The light of the point `u` (in `[0,1)²`) of the square reaching `p`.
+    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let AreaLight { position, normal, size, radiance } = *self;
+        sample_area(position, normal, size, radiance, p, u)
+    }
+}
+
+fn sample_area(position: Vec3, normal: Vec3, size: f32, radiance: Color, p: Vec3, u: Vec2) -> Option<LightSample> {
     let (a, b) = orthonormal_basis(normal);
     let q = position + (u.x - 0.5) * size * a + (u.y - 0.5) * size * b;
     let to_light = q - p;

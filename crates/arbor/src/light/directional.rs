@@ -1,10 +1,36 @@
 //! Directional lights (CENG 795 hw5): parallel light travelling along `direction`.
 
-use super::LightSample;
-use crate::math::{Color, Vec3};
+use super::{Light, LightSample};
+use crate::math::{Color, Vec2, Vec3};
 
-/// The light reaching any point: from `-direction`, unattenuated.
-pub fn sample_directional(direction: Vec3, radiance: Color) -> Option<LightSample> {
-    let wi = -direction.try_normalize()?;
-    Some(LightSample { wi, dist: f32::INFINITY, irradiance: radiance })
+/// Parallel light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirectionalLight {
+    /// Direction of travel (need not be unit).
+    pub direction: Vec3,
+    /// Irradiance on a surface facing it.
+    pub radiance: Color,
+}
+
+impl Light for DirectionalLight {
+    /// The light reaching any point: from `-direction`, unattenuated, from infinitely far.
+    fn sample(&self, _p: Vec3, _u: Vec2) -> Option<LightSample> {
+        let wi = -self.direction.try_normalize()?;
+        Some(LightSample { wi, dist: f32::INFINITY, irradiance: self.radiance })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directional_light_comes_from_against_its_direction() {
+        let light = DirectionalLight { direction: Vec3::new(0.0, -2.0, 0.0), radiance: Color::splat(3.0) };
+        let s = light.sample(Vec3::new(5.0, 1.0, -2.0), Vec2::ZERO).unwrap();
+        assert_eq!(s, LightSample { wi: Vec3::Y, dist: f32::INFINITY, irradiance: Color::splat(3.0) });
+        assert!(DirectionalLight { direction: Vec3::ZERO, radiance: Color::ONE }
+            .sample(Vec3::ZERO, Vec2::ZERO)
+            .is_none());
+    }
 }

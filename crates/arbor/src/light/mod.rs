@@ -1,17 +1,22 @@
-//! Lights: what a shading point receives from each light ([`LightSample`]), and the environment map for
-//! rays that miss.
+//! Lights at render time: what a shading point receives from each light ([`Light::sample`] gives a
+//! [`LightSample`]), and the environment map for rays that miss. The scene's build step makes the lights
+//! from the description; nothing here knows the scene file.
+//!
+//! A new kind of light is a type in its own file implementing [`Light`]; the integrator only asks the
+//! trait.
 
 mod area;
 mod directional;
 pub mod environment;
 mod point;
 
-use crate::math::{Color, Vec2, Vec3};
-use crate::scene::LightDesc;
+use std::fmt;
 
-pub use area::sample_area;
-pub use directional::sample_directional;
-pub use point::sample_point;
+use crate::math::{Color, Vec2, Vec3};
+
+pub use area::AreaLight;
+pub use directional::DirectionalLight;
+pub use point::PointLight;
 
 /// Light arriving at a point from one light (or one point on an area light).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,11 +29,9 @@ pub struct LightSample {
     pub irradiance: Color,
 }
 
-/// The light from `light` at point `p`; `u` picks the point on an area light.
-pub fn sample_light(light: &LightDesc, p: Vec3, u: Vec2) -> Option<LightSample> {
-    match *light {
-        LightDesc::Point { position, intensity } => sample_point(position, intensity, p),
-        LightDesc::Area { position, normal, size, radiance } => sample_area(position, normal, size, radiance, p, u),
-        LightDesc::Directional { direction, radiance } => sample_directional(direction, radiance),
-    }
+/// A light source other than the ambient light and the environment.
+pub trait Light: fmt::Debug + Send + Sync {
+    /// The light reaching point `p`; `u` (in `[0,1)²`) picks the point on a light with an area.
+    /// `None` when nothing arrives (`p` on a point light, a zero direction).
+    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample>;
 }

@@ -1,17 +1,27 @@
 //! Point lights: irradiance `intensity / d²` (the course's definition, no 4π).
 
-use super::LightSample;
-use crate::math::{Color, Vec3};
+use super::{Light, LightSample};
+use crate::math::{Color, Vec2, Vec3};
 
-/// The light a point light at `position` gives point `p`; `None` when `p` is at the light.
-pub fn sample_point(position: Vec3, intensity: Color, p: Vec3) -> Option<LightSample> {
-    let to_light = position - p;
-    let d2 = to_light.length_squared();
-    if !(d2 > 0.0) {
-        return None;
+/// Light from a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointLight {
+    /// Position.
+    pub position: Vec3,
+    /// Intensity.
+    pub intensity: Color,
+}
+
+impl Light for PointLight {
+    fn sample(&self, p: Vec3, _u: Vec2) -> Option<LightSample> {
+        let to_light = self.position - p;
+        let d2 = to_light.length_squared();
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let dist = d2.sqrt();
+        Some(LightSample { wi: to_light / dist, dist, irradiance: self.intensity / d2 })
     }
-    let dist = d2.sqrt();
-    Some(LightSample { wi: to_light / dist, dist, irradiance: intensity / d2 })
 }
 
 #[cfg(test)]
@@ -20,10 +30,11 @@ mod tests {
 
     #[test]
     fn point_light_falls_off_with_square_distance() {
-        let s = sample_point(Vec3::new(0.0, 2.0, 0.0), Vec3::splat(100.0), Vec3::ZERO).unwrap();
+        let light = PointLight { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(100.0) };
+        let s = light.sample(Vec3::ZERO, Vec2::ZERO).unwrap();
         assert_eq!(s.wi, Vec3::Y);
         assert_eq!(s.dist, 2.0);
         assert_eq!(s.irradiance, Vec3::splat(25.0));
-        assert!(sample_point(Vec3::ZERO, Vec3::ONE, Vec3::ZERO).is_none());
+        assert!(PointLight { position: Vec3::ZERO, intensity: Vec3::ONE }.sample(Vec3::ZERO, Vec2::ZERO).is_none());
     }
 }

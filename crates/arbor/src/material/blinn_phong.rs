@@ -1,11 +1,11 @@
 //! Blinn-Phong, as the courses define it: `k_d max(0, n·l) + k_s max(0, n·h)^p`, times the irradiance.
 
+use super::Material;
 use crate::math::{Color, Vec3};
-use crate::scene::MaterialDesc;
 
 /// The reflected fraction of light arriving from unit `wi` seen from unit `wo`, at shading normal `n`.
 #[inline]
-pub fn blinn_phong(m: &MaterialDesc, n: Vec3, wi: Vec3, wo: Vec3) -> Color {
+pub fn blinn_phong(m: &Material, n: Vec3, wi: Vec3, wo: Vec3) -> Color {
     let cos = n.dot(wi);
     if cos <= 0.0 {
         return Color::ZERO;
@@ -21,16 +21,14 @@ pub fn blinn_phong(m: &MaterialDesc, n: Vec3, wi: Vec3, wo: Vec3) -> Color {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::MaterialKind;
 
-    fn mat() -> MaterialDesc {
-        MaterialDesc {
-            id: "1".into(),
+    fn mat() -> Material {
+        Material {
             ambient: Color::ZERO,
             diffuse: Color::splat(0.5),
             specular: Color::splat(0.25),
             phong_exponent: 10.0,
-            kind: MaterialKind::BlinnPhong,
+            layer: None,
         }
     }
 

@@ -2,7 +2,7 @@
 //! conductor with complex index `eta + i k`, times `MirrorReflectance` (which gives metals their colour),
 //! in the approximation the course uses (the `n² + k²` form, exact at normal incidence).
 
-use super::Lobe;
+use super::{Lobe, SpecularLayer};
 use crate::math::{reflect, Color, Vec3};
 
 /// Fresnel reflectance of a conductor for the cosine `cos_i` of the incidence angle.
@@ -16,11 +16,24 @@ pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
     0.5 * (rs + rp)
 }
 
-/// The conductor's reflection lobe.
-pub fn lobe(reflectance: Color, eta: f32, k: f32, d: Vec3, n: Vec3) -> Lobe {
-    let cos_i = -d.dot(n);
-    let fr = fresnel_conductor(cos_i.abs(), eta, k);
-    Lobe { dir: reflect(d, n).normalize(), weight: reflectance * fr, transmitted: false }
+/// A metal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conductor {
+    /// `MirrorReflectance`.
+    pub reflectance: Color,
+    /// `RefractionIndex` (n).
+    pub eta: f32,
+    /// `AbsorptionIndex` (k).
+    pub k: f32,
+}
+
+impl SpecularLayer for Conductor {
+    /// The conductor's single reflection lobe.
+    fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe> {
+        let cos_i = -d.dot(n);
+        let fr = fresnel_conductor(cos_i.abs(), self.eta, self.k);
+        vec![Lobe { dir: reflect(d, n).normalize(), weight: self.reflectance * fr, transmitted: false }]
+    }
 }
 
 #[cfg(test)]
@@ -33,6 +46,16 @@ mod tests {
         let (n, k) = (0.37f32, 2.82f32);
         let expected = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
         assert!((fresnel_conductor(1.0, n, k) - expected).abs() < 1e-6);
+    }
+
+    #[test]
+    fn conductor_lobe_reflects_with_fresnel_times_reflectance() {
+        let m = Conductor { reflectance: Color::new(1.0, 0.5, 0.25), eta: 0.37, k: 2.82 };
+        let lobes = m.lobes(-Vec3::Y, Vec3::Y);
+        assert_eq!(lobes.len(), 1);
+        assert_eq!(lobes[0].dir, Vec3::Y);
+        assert_eq!(lobes[0].weight, m.reflectance * fresnel_conductor(1.0, 0.37, 2.82));
+        assert!(!m.transmits() && m.interior_absorption().is_none());
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! reflection, and Beer's law for the light travelling inside (applied by the integrator along each
 //! segment, since only it knows the distance).
 
-use super::Lobe;
+use super::{Lobe, SpecularLayer};
 use crate::math::{reflect, Color, Vec3};
 
 /// Fresnel reflectance for light going from index `eta_i` into `eta_t` with incidence cosine `cos_i`
@@ -30,6 +30,27 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     Some((eta * d + (eta * cos_i - k.sqrt()) * n).normalize())
 }
 
+/// Glass with Beer's law inside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dielectric {
+    /// `RefractionIndex`.
+    pub eta: f32,
+    /// `AbsorptionCoefficient`, per channel, per unit distance.
+    pub absorption: Color,
+}
+
+impl SpecularLayer for Dielectric {
+    fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe> {
+        lobes(self.eta, Color::ONE, d, n)
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+    fn interior_absorption(&self) -> Option<Color> {
+        Some(self.absorption)
+    }
+}
+
 /// Beer's law: the fraction of light left after `distance` in a medium absorbing `absorption` per unit.
 #[inline]
 pub fn beer(absorption: Color, distance: f32) -> Color {
@@ -38,7 +59,7 @@ pub fn beer(absorption: Color, distance: f32) -> Color {
 
 /// Reflection (weight F) and refraction (weight `(1 - F) * transmit`) at a surface of index `eta` with
 /// outward normal `n`, entered from whichever side `d` comes.
-pub fn lobes(eta: f32, transmit: Color, d: Vec3, n: Vec3) -> Vec<Lobe> {
+pub(super) fn lobes(eta: f32, transmit: Color, d: Vec3, n: Vec3) -> Vec<Lobe> {
     let entering = d.dot(n) < 0.0;
     let (facing, eta_i, eta_t) = if entering { (n, 1.0, eta) } else { (-n, eta, 1.0) };
     let cos_i = -d.dot(facing);
@@ -89,6 +110,15 @@ mod tests {
         let d = Vec3::new(0.3, -1.0, 0.2).normalize();
         let l = lobes(1.55, Color::ONE, d, Vec3::Y);
         assert!((l[0].weight.x + l[1].weight.x - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn dielectric_layer_transmits_into_its_absorbing_medium() {
+        let glass = Dielectric { eta: 1.5, absorption: Color::new(0.1, 0.2, 0.3) };
+        assert!(glass.transmits());
+        assert_eq!(glass.interior_absorption(), Some(Color::new(0.1, 0.2, 0.3)));
+        let d = Vec3::new(0.3, -1.0, 0.2).normalize();
+        assert_eq!(glass.lobes(d, Vec3::Y), lobes(1.5, Color::ONE, d, Vec3::Y));
     }
 
     #[test]

@@ -1,18 +1,26 @@
-//! Materials: the Blinn-Phong terms every material has ([`blinn_phong`]), and the perfectly specular
-//! lobes that mirrors, conductors and dielectrics add ([`specular_lobes`]), each in the file named after
-//! its scene-file `type`.
+//! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong`]), and the
+//! perfectly specular layer that mirrors, conductors and dielectrics add ([`SpecularLayer`]), each in
+//! the file named after its scene-file `type`. The scene's build step makes a [`Material`] from each
+//! material of the description; nothing here knows the scene file.
+//!
+//! A new kind of specular behaviour is a type in its own file implementing [`SpecularLayer`]; the
+//! integrator only asks the trait.
 
 mod blinn_phong;
 mod conductor;
 mod dielectric;
 mod mirror;
+mod transparent;
+
+use std::fmt;
 
 use crate::math::{Color, Vec3};
-use crate::scene::MaterialKind;
 
 pub use blinn_phong::blinn_phong;
-pub use conductor::fresnel_conductor;
-pub use dielectric::{beer, fresnel_dielectric, refract};
+pub use conductor::{fresnel_conductor, Conductor};
+pub use dielectric::{beer, fresnel_dielectric, refract, Dielectric};
+pub use mirror::Mirror;
+pub use transparent::Transparent;
 
 /// One perfectly specular continuation of a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,20 +33,58 @@ pub struct Lobe {
     pub transmitted: bool,
 }
 
-/// Up to three specular lobes of a material hit by unit direction `d` at a surface with unit outward
-/// normal `n` (the side the normal faces is "outside" for refraction).
-pub fn specular_lobes(kind: &MaterialKind, d: Vec3, n: Vec3) -> Vec<Lobe> {
-    match kind {
-        MaterialKind::BlinnPhong => Vec::new(),
-        MaterialKind::Mirror { reflectance } => vec![mirror::lobe(*reflectance, d, n)],
-        MaterialKind::Conductor { reflectance, eta, k } => vec![conductor::lobe(*reflectance, *eta, *k, d, n)],
-        MaterialKind::Dielectric { eta, .. } => dielectric::lobes(*eta, Color::ONE, d, n),
-        MaterialKind::Transparent { eta, transparency, mirror: m } => {
-            let mut lobes = dielectric::lobes(*eta, *transparency, d, n);
-            if *m != Color::ZERO {
-                lobes.push(mirror::lobe(*m, d, n));
-            }
-            lobes
-        }
+/// What a material adds to its Blinn-Phong terms: perfectly specular lobes, and for glass a medium
+/// behind the surface.
+pub trait SpecularLayer: fmt::Debug + Send + Sync {
+    /// The lobes at a surface with unit outward normal `n` hit by unit direction `d` (the side the
+    /// normal faces is "outside" for refraction).
+    fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe>;
+
+    /// Whether light crosses the surface. Such a surface hit from inside only refracts and reflects: its
+    /// ambient and Blinn-Phong terms belong to its outside.
+    fn transmits(&self) -> bool {
+        false
+    }
+
+    /// The absorption per channel and unit distance (Beer's law) of the medium a transmitted ray
+    /// enters when it comes from outside; `None` for a medium that absorbs nothing on its way.
+    fn interior_absorption(&self) -> Option<Color> {
+        None
+    }
+}
+
+/// A material ready for shading.
+#[derive(Debug)]
+pub struct Material {
+    /// k_a: multiplies the scene's ambient light.
+    pub ambient: Color,
+    /// k_d.
+    pub diffuse: Color,
+    /// k_s.
+    pub specular: Color,
+    /// Blinn-Phong exponent.
+    pub phong_exponent: f32,
+    /// Mirror, conductor, dielectric...; `None` for Blinn-Phong only (no secondary rays).
+    pub layer: Option<Box<dyn SpecularLayer>>,
+}
+
+impl Material {
+    /// The specular lobes at a surface with unit outward normal `n` hit by unit direction `d`; none
+    /// for a Blinn-Phong-only material.
+    #[inline]
+    pub fn specular_lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe> {
+        self.layer.as_ref().map_or_else(Vec::new, |l| l.lobes(d, n))
+    }
+
+    /// Whether light crosses the surface ([`SpecularLayer::transmits`]).
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        self.layer.as_ref().is_some_and(|l| l.transmits())
+    }
+
+    /// The absorption of the medium behind the surface ([`SpecularLayer::interior_absorption`]).
+    #[inline]
+    pub fn interior_absorption(&self) -> Option<Color> {
+        self.layer.as_ref().and_then(|l| l.interior_absorption())
     }
 }

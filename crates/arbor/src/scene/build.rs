@@ -1,341 +1,131 @@
-//! From description to runtime scene, in two levels (Embree's scenes and instances): every mesh gets
-//! its own acceleration structure over its triangles in object space, and one top-level structure of
-//! the same kind indexes the scene's objects (meshes, spheres, instances) by their world bounds. An
-//! object with a transform is intersected by taking the ray into its object space (the direction is
-//! not normalised, so `t` is the same in both spaces); a `MeshInstance` reuses its base mesh's
-//! geometry and structure through its own transform, without copying either. Infinite planes have no
-//! bounds and are tested one by one after the hierarchy.
-//!
-//! Mesh files are read once each, in parallel, and the per-mesh structures are built in parallel.
-//! Ties between objects go to the lower object index, and inside an object to the lower triangle
-//! index, so every structure kind gives the same hits as brute force at both levels.
+//! The build step, the one way from a description to a runtime scene ([`Scene::build`]): it loads the
+//! assets (mesh files, each distinct file once and in parallel; the environment map), gives every mesh
+//! object its own acceleration structure (in parallel), resolves instances to the mesh they show, puts
+//! the objects under one top-level structure ([`super::geometry`]), and turns the description's
+//! materials, lights and cameras into their runtime types. Asset errors name the scene element that
+//! asked for the file. Nothing after this step reads the description.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::desc::{MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
-use crate::accel::{Accel, AccelConfig, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
+use super::desc::{
+    CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule, SceneDesc, ShapeDesc,
+};
+use super::geometry::{prim_count, world_box, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
+use super::runtime::{RayOffset, Scene};
+use crate::accel::{AccelConfig, Primitives};
+use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
-use crate::math::{Aabb, Ray, Transform, Vec3};
-use crate::{Error, Result};
+use crate::light::environment::EnvMap;
+use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
+use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
+use crate::{Error, Location, Result};
 
-/// Scenes of at most this many bounded objects trace batches object by object
-/// ([`SceneGeometry::intersect_many`]): up to one wide node's fan-out, what a ray pays for meeting every
-/// object's root is about what a walk of the top level costs it.
-pub const SWEEP_OBJECTS: usize = 8;
-
-/// A mesh in object space under its own structure; shared by every object that shows it.
-pub struct MeshShape {
-    /// Triangles in object space; `normals` are set for smooth shading only.
-    pub mesh: TriangleMesh,
-    /// The structure over `mesh`'s triangles.
-    pub accel: Box<dyn Accel<TriangleMesh>>,
-}
-
-/// What an object is made of.
-#[derive(Clone)]
-pub enum Shape {
-    /// A triangle mesh (possibly shared with instances).
-    Mesh(Arc<MeshShape>),
-    /// A sphere (its transform is its own).
-    Sphere(Sphere),
-}
-
-/// One bounded object of the runtime scene.
-#[derive(Clone)]
-pub struct SceneObject {
-    /// Geometry.
-    pub shape: Shape,
-    /// Object to world for meshes (spheres carry theirs); `None` for the identity.
-    pub transform: Option<Transform>,
-    /// World-space bounds.
-    pub bounds: Aabb,
-    /// Index into the description's objects.
-    pub object: u32,
-    /// Global index of the object's first primitive (for primitive ids across the whole scene).
-    pub first_prim: u32,
-}
-
-impl SceneObject {
-    /// The ray in object space (same `t` as in world space).
-    #[inline]
-    fn local_ray(&self, ray: &Ray) -> Ray {
-        match &self.transform {
-            None => *ray,
-            Some(t) => Ray::new(t.inv.transform_point3(ray.origin), t.inv.transform_vector3(ray.dir))
-                .with_culling(ray.cull_backfaces),
-        }
+impl Scene {
+    /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
+    /// both levels. `environment` overrides the scene's own map.
+    pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
+        let environment = match environment {
+            Some(env) => Some(env),
+            None => load_environment(&desc)?,
+        };
+        let start = Instant::now();
+        let geometry = build_geometry(&desc, spec)?;
+        let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
+        let offset = match desc.offset {
+            OffsetRule::ShadowEpsilon => RayOffset::ShadowEpsilon(desc.shadow_epsilon),
+            OffsetRule::ErrorBound => RayOffset::ErrorBound,
+        };
+        Ok(Scene {
+            geometry,
+            materials: desc.materials.iter().map(build_material).collect(),
+            object_materials: desc.objects.iter().map(|o| o.material).collect(),
+            lights: desc.lights.iter().map(build_light).collect(),
+            cameras: desc.cameras.iter().map(build_camera).collect(),
+            environment,
+            background: desc.background,
+            ambient: desc.ambient,
+            radiance_scale: desc.radiance_scale,
+            max_depth: desc.max_depth,
+            shadows: desc.shadows,
+            cull_backfaces: desc.cull_backfaces,
+            offset,
+            build_time,
+        })
     }
 }
 
-/// The scene's bounded objects, as primitives of the top-level structure.
-#[derive(Default)]
-pub struct SceneObjects {
-    /// Objects, in description order (planes excluded).
-    pub objects: Vec<SceneObject>,
-}
-
-impl Primitives for SceneObjects {
-    fn len(&self) -> usize {
-        self.objects.len()
-    }
-    fn bounds(&self, i: usize) -> Aabb {
-        self.objects[i].bounds
-    }
-    #[inline]
-    fn intersect(&self, i: usize, ray: &Ray, t_max: f32) -> Option<PrimHit> {
-        let o = &self.objects[i];
-        match &o.shape {
-            Shape::Mesh(m) => m.accel.intersect(&m.mesh, &o.local_ray(ray), t_max).map(nested),
-            Shape::Sphere(s) => s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0)),
-        }
-    }
-    fn occludes(&self, i: usize, ray: &Ray, t_max: f32) -> bool {
-        let o = &self.objects[i];
-        match &o.shape {
-            Shape::Mesh(m) => m.accel.occluded(&m.mesh, &o.local_ray(ray), t_max),
-            Shape::Sphere(s) => s.intersect(ray, t_max).is_some(),
-        }
-    }
-    fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {
-        let o = &self.objects[i];
-        match &o.shape {
-            Shape::Mesh(m) => m.accel.intersect_counted(&m.mesh, &o.local_ray(ray), t_max, counts).map(nested),
-            Shape::Sphere(s) => {
-                counts.prims += 1;
-                s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
-            }
-        }
-    }
-}
-
-/// An object's hit as seen from the top level: the triangle becomes the sub-primitive.
-#[inline]
-fn nested(h: Hit) -> PrimHit {
-    PrimHit { t: h.t, u: h.u, v: h.v, sub: h.prim }
-}
-
-/// What a scene holds, for summaries and `arbor info`.
-#[derive(Debug, Clone, Default)]
-pub struct SceneCounts {
-    /// Triangles as rendered (an instanced mesh counts once per instance).
-    pub triangles: usize,
-    /// Triangles stored (each mesh once).
-    pub unique_triangles: usize,
-    /// Degenerate triangles among the stored ones (zero area: never hit).
-    pub degenerate: usize,
-    /// Spheres.
-    pub spheres: usize,
-    /// Infinite planes.
-    pub planes: usize,
-    /// Objects under the top-level structure.
-    pub objects: usize,
-    /// Time spent reading mesh files.
-    pub mesh_load: Duration,
-}
-
-/// The geometry of a scene under its two-level acceleration structure.
-pub struct SceneGeometry {
-    /// The bounded objects.
-    pub objects: SceneObjects,
-    /// The top-level structure over `objects`.
-    pub top: Box<dyn Accel<SceneObjects>>,
-    /// Every distinct mesh with its structure.
-    pub meshes: Vec<Arc<MeshShape>>,
-    /// Infinite planes and their description objects.
-    pub planes: Vec<(Plane, u32)>,
-    /// Counts.
-    pub counts: SceneCounts,
-}
-
-impl SceneGeometry {
-    /// The closest hit of `ray` in `(0, t_max)`: `prim` is the object (planes come after the bounded
-    /// objects), `sub` the triangle inside a mesh.
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        if !ray.is_valid() {
-            return None;
-        }
-        let best = self.top.intersect(&self.objects, ray, t_max);
-        self.intersect_planes(ray, t_max, best, None)
-    }
-
-    /// [`SceneGeometry::intersect`] for a batch (the camera rays of a few pixels): `out[i]` becomes
-    /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
-    ///
-    /// A scene of at most [`SWEEP_OBJECTS`] bounded objects is swept object by object, each mesh
-    /// tracing the whole batch at once ([`Accel::intersect_many`], which the BVH traces two rays at a
-    /// time) up to the closest hit found so far, which a later object must beat strictly: the smallest
-    /// `t` wins and ties go to the lowest object, as at the top level. Past that many objects, each ray
-    /// walks the top level on its own, which skips the objects it does not come near.
-    ///
-    /// # Panics
-    /// When `rays` and `out` differ in length.
-    pub fn intersect_many(&self, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
-        let objects = &self.objects.objects;
-        if objects.len() > SWEEP_OBJECTS {
-            for (o, r) in out.iter_mut().zip(rays) {
-                *o = self.intersect(r, t_max);
-            }
-            return;
-        }
-        out.fill(None);
-        let mut limit = vec![t_max; rays.len()];
-        let (mut local, mut found) = (Vec::new(), Vec::new());
-        for (i, object) in objects.iter().enumerate() {
-            match &object.shape {
-                Shape::Mesh(m) => {
-                    local.clear();
-                    local.extend(rays.iter().map(|r| object.local_ray(r)));
-                    found.resize(rays.len(), None);
-                    m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
-                    for ((o, l), h) in out.iter_mut().zip(&mut limit).zip(&found) {
-                        if let Some(h) = h {
-                            *o = Some(Hit::new(i as u32, nested(*h)));
-                            *l = h.t;
-                        }
-                    }
-                }
-                Shape::Sphere(_) => {
-                    for ((o, l), r) in out.iter_mut().zip(&mut limit).zip(rays) {
-                        if let Some(h) = self.objects.intersect(i, r, *l) {
-                            *o = Some(Hit::new(i as u32, h));
-                            *l = h.t;
-                        }
-                    }
-                }
-            }
-        }
-        // An invalid ray hits nothing, planes included, as in `intersect`.
-        for (o, r) in out.iter_mut().zip(rays) {
-            *o = if r.is_valid() { self.intersect_planes(r, t_max, *o, None) } else { None };
-        }
-    }
-
-    /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested at both levels to
-    /// `counts` (the traversal-cost heatmap).
-    pub fn intersect_counted(&self, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
-        if !ray.is_valid() {
-            return None;
-        }
-        let best = self.top.intersect_counted(&self.objects, ray, t_max, counts);
-        self.intersect_planes(ray, t_max, best, Some(counts))
-    }
-
-    fn intersect_planes(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        mut best: Option<Hit>,
-        mut counts: Option<&mut TraversalCounts>,
-    ) -> Option<Hit> {
-        let base = self.objects.len() as u32;
-        for (k, (plane, _)) in self.planes.iter().enumerate() {
-            if let Some(c) = counts.as_deref_mut() {
-                c.prims += 1;
-            }
-            if let Some(t) = plane.intersect(ray, best.map_or(t_max, |h| h.t)) {
-                best = Some(Hit { t, prim: base + k as u32, u: 0.0, v: 0.0, sub: 0 });
-            }
-        }
-        best
-    }
-
-    /// Whether anything lies on `ray` in `(0, t_max)`.
-    #[inline]
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        ray.is_valid()
-            && (self.planes.iter().any(|(p, _)| p.intersect(ray, t_max).is_some())
-                || self.top.occluded(&self.objects, ray, t_max))
-    }
-
-    /// A scene-wide id of the primitive hit (triangle, sphere or plane), the same for every structure.
-    pub fn global_prim_id(&self, hit: &Hit) -> u32 {
-        match self.objects.objects.get(hit.prim as usize) {
-            Some(o) => o.first_prim + hit.sub,
-            None => {
-                let bounded = self.objects.objects.last().map_or(0, |o| o.first_prim + prim_count(&o.shape));
-                bounded + (hit.prim - self.objects.len() as u32)
-            }
-        }
-    }
-
-    /// The world-space boxes of the nodes at `depth` of the top-level structure and of every mesh's
-    /// structure (the boxes debug view).
-    pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
-        let mut out = self.top.boxes_at_depth(depth);
-        for o in &self.objects.objects {
-            if let Shape::Mesh(m) = &o.shape {
-                let boxes = m.accel.boxes_at_depth(depth);
-                out.extend(boxes.into_iter().map(|b| world_box(&b, o.transform.as_ref())));
-            }
-        }
-        out
-    }
-
-    /// Statistics of the structures together: the top level plus every distinct mesh's structure
-    /// (counts and bytes summed; depths through both levels; the SAH cost is the top level's plus each
-    /// mesh's weighted by the share of the scene's area its object covers, an estimate).
-    pub fn accel_stats(&self) -> AccelStats {
-        let top = self.top.stats();
-        let mut s = AccelStats { primitives: 0, ..top.clone() };
-        let (mut leaf_prims, mut depth_sum, mut refs) = (0.0, 0.0, 0.0);
-        let scene_area = self.bounds().area().max(f32::MIN_POSITIVE) as f64;
-        let mut mesh_max_depth = 0;
-        for m in &self.meshes {
-            let ms = m.accel.stats();
-            s.primitives += ms.primitives;
-            s.nodes += ms.nodes;
-            s.leaves += ms.leaves;
-            s.bytes += ms.bytes;
-            s.build_time += ms.build_time;
-            mesh_max_depth = mesh_max_depth.max(ms.max_depth);
-            leaf_prims += ms.mean_leaf_prims * ms.leaves as f64;
-            depth_sum += ms.mean_depth * ms.leaves as f64;
-            refs += ms.refs_per_prim * ms.primitives as f64;
-            s.sah_cost += ms.sah_cost * (m.accel.bounds().area() as f64 / scene_area).min(1.0);
-        }
-        s.primitives += self.counts.spheres;
-        refs += self.counts.spheres as f64;
-        s.max_depth = top.max_depth + mesh_max_depth;
-        let mesh_leaves = (s.leaves - top.leaves) as f64;
-        if mesh_leaves > 0.0 {
-            s.mean_leaf_prims = leaf_prims / mesh_leaves;
-            s.mean_depth = top.mean_depth + depth_sum / mesh_leaves;
-        }
-        s.refs_per_prim = if s.primitives > 0 { refs / s.primitives as f64 } else { 0.0 };
-        s
-    }
-
-    /// Bounds of the bounded objects.
-    pub fn bounds(&self) -> Aabb {
-        self.top.bounds()
-    }
-}
-
-fn prim_count(shape: &Shape) -> u32 {
-    match shape {
-        Shape::Mesh(m) => m.mesh.len() as u32,
-        Shape::Sphere(_) => 1,
-    }
-}
-
-/// The world box of an object-space box.
-fn world_box(b: &Aabb, t: Option<&Transform>) -> Aabb {
-    let Some(t) = t else { return *b };
-    (0..8).fold(Aabb::EMPTY, |acc, i| {
-        let corner = Vec3::new(
-            if i & 1 == 0 { b.min.x } else { b.max.x },
-            if i & 2 == 0 { b.min.y } else { b.max.y },
-            if i & 4 == 0 { b.min.z } else { b.max.z },
-        );
-        acc.grow(t.point(corner))
+/// The environment map the scene names, if any. A map that cannot be read is the scene's fault, like a
+/// missing mesh: located where the file names it.
+fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
+    let Some(path) = desc.environment.as_deref() else { return Ok(None) };
+    EnvMap::load(path).map(Some).map_err(|e| match e {
+        Error::Io { source, .. } => Error::input(
+            desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
+            format!("cannot read environment map '{}': {source}", path.display()),
+        ),
+        other => other,
     })
+}
+
+/// The runtime camera of a description: its transform applied to position, gaze and up.
+pub fn build_camera(desc: &CameraDesc) -> Camera {
+    let t = &desc.transform;
+    let w = &desc.window;
+    let plane = ImagePlane { left: w.left, right: w.right, bottom: w.bottom, top: w.top, distance: desc.near_distance };
+    let projection = match desc.lens {
+        _ if desc.orthographic => Projection::Orthographic,
+        Some(l) => Projection::ThinLens { aperture: l.aperture, focus_distance: l.focus_distance },
+        None => Projection::Pinhole,
+    };
+    let mut camera = Camera::new(
+        t.point(desc.position),
+        t.vector(desc.gaze),
+        t.vector(desc.up),
+        plane,
+        projection,
+        desc.width,
+        desc.height,
+    );
+    camera.id = desc.id.clone();
+    camera.image_name = desc.image_name.clone();
+    camera.num_samples = desc.num_samples;
+    camera
+}
+
+/// The runtime material of a description.
+fn build_material(desc: &MaterialDesc) -> Material {
+    let layer: Option<Box<dyn SpecularLayer>> = match desc.kind {
+        MaterialKind::BlinnPhong => None,
+        MaterialKind::Mirror { reflectance } => Some(Box::new(Mirror { reflectance })),
+        MaterialKind::Conductor { reflectance, eta, k } => Some(Box::new(Conductor { reflectance, eta, k })),
+        MaterialKind::Dielectric { eta, absorption } => Some(Box::new(Dielectric { eta, absorption })),
+        MaterialKind::Transparent { eta, transparency, mirror } => {
+            Some(Box::new(Transparent { eta, transparency, mirror }))
+        }
+    };
+    Material {
+        ambient: desc.ambient,
+        diffuse: desc.diffuse,
+        specular: desc.specular,
+        phong_exponent: desc.phong_exponent,
+        layer,
+    }
+}
+
+/// The runtime light of a description.
+fn build_light(desc: &LightDesc) -> Box<dyn Light> {
+    match *desc {
+        LightDesc::Point { position, intensity } => Box::new(PointLight { position, intensity }),
+        LightDesc::Area { position, normal, size, radiance } => {
+            Box::new(AreaLight { position, normal, size, radiance })
+        }
+        LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+    }
 }
 
 /// Loads the meshes of `desc` and builds its geometry under the structure `spec` describes, at both
@@ -475,4 +265,99 @@ fn load_mesh_files(desc: &SceneDesc) -> Result<HashMap<PathBuf, Arc<TriangleMesh
             Ok(((*path).clone(), Arc::new(mesh)))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Color, Transform, Vec2, Vec3};
+    use crate::scene::desc::{Lens, Window};
+
+    fn camera_desc() -> CameraDesc {
+        CameraDesc {
+            id: "7".into(),
+            position: Vec3::new(0.0, 0.0, 20.0),
+            gaze: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::new(0.0, 1.0, 0.0),
+            window: Window { left: -10.0, right: 10.0, bottom: -10.0, top: 10.0 },
+            near_distance: 10.0,
+            orthographic: false,
+            width: 800,
+            height: 800,
+            image_name: "x.png".into(),
+            num_samples: 4,
+            transform: Transform::IDENTITY,
+            lens: None,
+            loc: Location::file("x.xml"),
+        }
+    }
+
+    #[test]
+    fn build_camera_keeps_image_and_applies_transform() {
+        let mut d = camera_desc();
+        d.transform = Transform::rotate(90.0, Vec3::Y).unwrap();
+        let cam = build_camera(&d);
+        assert_eq!((cam.id.as_str(), cam.image_name.as_str(), cam.num_samples), ("7", "x.png", 4));
+        assert_eq!((cam.width, cam.height), (800, 800));
+        let r = cam.ray(400, 400, Vec2::ZERO, Vec2::ZERO);
+        assert!(r.origin.abs_diff_eq(Vec3::new(20.0, 0.0, 0.0), 1e-4));
+        assert!(r.dir.abs_diff_eq(-Vec3::X, 1e-6));
+    }
+
+    #[test]
+    fn build_camera_picks_the_projection() {
+        let lens = Some(Lens { aperture: 2.0, focus_distance: 15.0 });
+        let thin = build_camera(&CameraDesc { lens, ..camera_desc() });
+        let a = thin.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9));
+        assert_ne!(a.origin, Vec3::new(0.0, 0.0, 20.0), "a thin lens starts rays off the eye");
+        // An orthographic camera ignores the lens: parallel rays along the gaze.
+        let ortho = build_camera(&CameraDesc { lens, orthographic: true, ..camera_desc() });
+        let o = ortho.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9));
+        assert_eq!(o.dir, -Vec3::Z);
+        let pinhole = build_camera(&camera_desc());
+        assert_eq!(pinhole.ray(10, 10, Vec2::splat(0.5), Vec2::new(0.1, 0.9)).origin, Vec3::new(0.0, 0.0, 20.0));
+    }
+
+    #[test]
+    fn build_material_maps_every_kind() {
+        let desc = |kind| MaterialDesc {
+            id: "m".into(),
+            ambient: Color::splat(0.1),
+            diffuse: Color::splat(0.2),
+            specular: Color::splat(0.3),
+            phong_exponent: 5.0,
+            kind,
+        };
+        let plain = build_material(&desc(MaterialKind::BlinnPhong));
+        assert!(plain.layer.is_none() && !plain.transmits());
+        assert_eq!(
+            (plain.ambient, plain.diffuse, plain.specular, plain.phong_exponent),
+            (Color::splat(0.1), Color::splat(0.2), Color::splat(0.3), 5.0)
+        );
+        let glass = build_material(&desc(MaterialKind::Dielectric { eta: 1.5, absorption: Color::splat(0.25) }));
+        assert!(glass.transmits());
+        assert_eq!(glass.interior_absorption(), Some(Color::splat(0.25)));
+        let legacy =
+            build_material(&desc(MaterialKind::Transparent { eta: 1.5, transparency: Color::ONE, mirror: Color::ONE }));
+        assert!(legacy.transmits() && legacy.interior_absorption().is_none());
+        let d = Vec3::new(0.0, -1.0, 0.0);
+        assert_eq!(legacy.specular_lobes(d, Vec3::Y).len(), 3);
+        let mirror = build_material(&desc(MaterialKind::Mirror { reflectance: Color::ONE }));
+        assert_eq!(mirror.specular_lobes(d, Vec3::Y)[0].dir, Vec3::Y);
+        let metal = build_material(&desc(MaterialKind::Conductor { reflectance: Color::ONE, eta: 0.4, k: 2.8 }));
+        assert!(!metal.transmits() && metal.specular_lobes(d, Vec3::Y).len() == 1);
+    }
+
+    #[test]
+    fn build_light_maps_every_kind() {
+        let p = Vec3::new(0.0, 0.0, 0.0);
+        let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) });
+        assert_eq!(point.sample(p, Vec2::ZERO).unwrap().irradiance, Color::ONE);
+        let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) });
+        assert_eq!(dir.sample(p, Vec2::ZERO).unwrap().wi, Vec3::Y);
+        let area =
+            LightDesc::Area { position: Vec3::Y * 4.0, normal: -Vec3::Y, size: 0.5, radiance: Color::splat(64.0) };
+        let s = build_light(&area).sample(p, Vec2::splat(0.5)).unwrap();
+        assert!((s.irradiance.x - 64.0 * 0.25 / 16.0).abs() < 1e-5);
+    }
 }

@@ -1,7 +1,8 @@
 //! The format-neutral scene description: what every reader (METU XML, METU JSON, NYU JSON) produces and
-//! what [`super::build`] turns into a runtime scene. Everything in it is resolved (ids to indices, look-at
-//! cameras to image-plane windows, named transforms to matrices) except mesh files, which are loaded at
-//! build time; each object keeps the place in the scene file it came from, for error messages.
+//! what the build step ([`super::Scene::build`]) turns into a runtime scene; plain data, read by nothing
+//! after the build. Everything in it is resolved (ids to indices, look-at cameras to image-plane windows,
+//! named transforms to matrices) except assets (mesh files, environment maps), which are loaded at build
+//! time; each object keeps the place in the scene file it came from, for error messages.
 
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -7,7 +7,7 @@
 //! samples are hours of rendering. [`SceneLimits::none`] lifts them all (`arbor render --no-limits`).
 //! Every refusal names the limit, the value asked for and where the scene asks for it.
 
-use super::SceneDesc;
+use super::desc::SceneDesc;
 use crate::{Error, Location, Result};
 
 /// How the user lifts the limits, for the messages.

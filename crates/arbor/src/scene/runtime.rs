@@ -1,75 +1,88 @@
-//! The runtime scene: the description, its geometry under an acceleration structure, and the
-//! environment map; plus the shading data of a hit, computed once from the final [`Hit`] only (the
-//! structures never touch normals or materials).
+//! The runtime scene: geometry under its acceleration structures ([`super::geometry`]), materials,
+//! lights, cameras, the environment map and the settings shading needs, all in runtime types (the build
+//! step, [`super::build`], makes them from a description; nothing here reads the description); plus the
+//! shading data of a hit, computed once from the final [`Hit`] only (the structures never touch normals
+//! or materials).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use super::build::{build_geometry, SceneGeometry, Shape};
-use super::desc::{MaterialDesc, OffsetRule, SceneDesc};
-use crate::accel::{AccelConfig, Hit};
+use super::geometry::{SceneGeometry, Shape};
+use crate::accel::Hit;
+use crate::camera::Camera;
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
-use crate::math::{Ray, Vec3};
-use crate::{Error, Location, Result};
+use crate::light::Light;
+use crate::material::Material;
+use crate::math::{Color, Ray, Vec3};
 
 /// A scene ready to render.
 pub struct Scene {
-    /// What the file said.
-    pub desc: SceneDesc,
     /// World-space primitives under an acceleration structure.
     pub geometry: SceneGeometry,
+    /// Materials; [`Scene::object_materials`] says which object has which.
+    pub materials: Vec<Material>,
+    /// The index into [`Scene::materials`] of each object, in scene-file order (the `object` of a
+    /// [`Surface`]).
+    pub object_materials: Vec<usize>,
+    /// Lights other than the ambient light and the environment.
+    pub lights: Vec<Box<dyn Light>>,
+    /// One image per camera.
+    pub cameras: Vec<Camera>,
     /// Seen by rays that miss, when the scene or the user names one.
     pub environment: Option<EnvMap>,
-    /// Wall time of the structure's build (mesh loading excluded).
+    /// Radiance of camera rays that hit nothing (and have no environment map).
+    pub background: Color,
+    /// Ambient radiance, added as `ambient reflectance * ambient` everywhere, shadowed or not.
+    pub ambient: Color,
+    /// Multiplies the scene's radiance to get display units (1.0 = white).
+    pub radiance_scale: f32,
+    /// Bounces of specular rays; 0 means none.
+    pub max_depth: u32,
+    /// Whether lights are tested for occlusion.
+    pub shadows: bool,
+    /// The scene's own back-face culling choice for camera rays, if it makes one.
+    pub cull_backfaces: Option<bool>,
+    /// Where secondary rays start.
+    pub offset: RayOffset,
+    /// Wall time of the structures' build (mesh loading excluded).
     pub build_time: Duration,
+}
+
+/// How far secondary rays (shadow, reflected, refracted) start from the surface they leave.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RayOffset {
+    /// By this distance along the geometric normal (the METU formats' `ShadowRayEpsilon`; their
+    /// reference images depend on it).
+    ShadowEpsilon(f32),
+    /// By the floating-point error bound of the hit point (pbrt-v4's `OffsetRayOrigin`,
+    /// [`crate::geometry::error_bound`]), for scenes that give no epsilon.
+    ErrorBound,
 }
 
 /// The shading data at a hit.
 #[derive(Debug, Clone, Copy)]
 pub struct Surface {
-    /// World-space point: `o + t d` under [`OffsetRule::ShadowEpsilon`]; recomputed from the surface's
-    /// own parameters (barycentrics, reprojection) under [`OffsetRule::ErrorBound`].
+    /// World-space point: `o + t d` under [`RayOffset::ShadowEpsilon`]; recomputed from the surface's
+    /// own parameters (barycentrics, reprojection) under [`RayOffset::ErrorBound`].
     pub p: Vec3,
-    /// Per-component bound on the error of `p` under [`OffsetRule::ErrorBound`] (zero otherwise).
+    /// Per-component bound on the error of `p` under [`RayOffset::ErrorBound`] (zero otherwise).
     pub p_error: Vec3,
     /// Unit geometric normal, outward (counter-clockwise side for triangles).
     pub ng: Vec3,
     /// Unit shading normal (interpolated for smooth meshes), on the same side as `ng`.
     pub ns: Vec3,
-    /// Index into the description's objects.
+    /// Index of the object hit, in scene-file order.
     pub object: u32,
-    /// Index into the description's materials.
+    /// Index into [`Scene::materials`].
     pub material: usize,
 }
 
 impl Scene {
-    /// Loads the meshes and builds the structure. `environment` overrides the scene's own map.
-    pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
-        let environment = match environment {
-            Some(env) => Some(env),
-            None => match desc.environment.as_deref() {
-                None => None,
-                // A map the scene names but that cannot be read is the scene's fault, like a missing mesh.
-                Some(path) => Some(EnvMap::load(path).map_err(|e| match e {
-                    Error::Io { source, .. } => Error::input(
-                        desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
-                        format!("cannot read environment map '{}': {source}", path.display()),
-                    ),
-                    other => other,
-                })?),
-            },
-        };
-        let start = Instant::now();
-        let geometry = build_geometry(&desc, spec)?;
-        let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
-        Ok(Scene { desc, geometry, environment, build_time })
-    }
-
     /// The material of a surface.
     #[inline]
-    pub fn material(&self, s: &Surface) -> &MaterialDesc {
-        &self.desc.materials[s.material]
+    pub fn material(&self, s: &Surface) -> &Material {
+        &self.materials[s.material]
     }
 
     /// Shading data for `hit`, found on `ray`.
@@ -77,7 +90,7 @@ impl Scene {
         let g = &self.geometry;
         let mut p = ray.at(hit.t);
         let mut p_error = Vec3::ZERO;
-        let bound = self.desc.offset == OffsetRule::ErrorBound;
+        let bound = self.offset == RayOffset::ErrorBound;
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
                 let (ng, ns) = match &o.shape {
@@ -120,7 +133,7 @@ impl Scene {
                 (plane.normal, plane.normal, *object)
             }
         };
-        Surface { p, p_error, ng, ns, object, material: self.desc.objects[object as usize].material }
+        Surface { p, p_error, ng, ns, object, material: self.object_materials[object as usize] }
     }
 }
 

@@ -21,8 +21,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::tree::{Node, Unused};
-use super::{LightDesc, SceneDesc};
 use crate::math::{Mat4, Transform, Vec3};
+use crate::scene::desc::{LightDesc, SceneDesc};
 use crate::{Error, Location, Result};
 
 /// Which form of the schema a file is written in.
@@ -355,7 +355,8 @@ mod objects;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{xml, ShapeDesc};
+    use crate::scene::desc::ShapeDesc;
+    use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
         let path = Path::new("t.xml");

@@ -13,8 +13,8 @@ use std::sync::Arc;
 use super::Reader;
 use crate::geometry::TriangleMesh;
 use crate::math::Vec3;
-use crate::scene::tree::{Attr, Node};
-use crate::scene::{MeshSource, ObjectDesc, ShapeDesc};
+use crate::scene::desc::{MeshSource, ObjectDesc, ShapeDesc};
+use crate::scene::readers::tree::{Attr, Node};
 use crate::{Error, Result};
 
 /// A `MeshInstance` waiting for its base; its own transform is already in its object.

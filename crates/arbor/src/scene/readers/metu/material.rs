@@ -4,8 +4,8 @@
 
 use super::Reader;
 use crate::math::Color;
-use crate::scene::tree::Node;
-use crate::scene::{MaterialDesc, MaterialKind};
+use crate::scene::desc::{MaterialDesc, MaterialKind};
+use crate::scene::readers::tree::Node;
 use crate::{Error, Result};
 
 impl Reader<'_> {

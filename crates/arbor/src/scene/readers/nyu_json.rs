@@ -17,9 +17,11 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::json::{self, Member, Spanned, Value};
-use super::{CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, ShapeDesc, Window};
 use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
+use crate::scene::desc::{
+    CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule, SceneDesc, ShapeDesc, Window,
+};
 use crate::{Error, Location, Result};
 
 const WIDTH: u32 = 640;
@@ -40,7 +42,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
     // The format gives no epsilon: offsets follow the hit point's error bound (shadow_epsilon stays
     // the 1e-4 reported before, unused).
     desc.shadow_epsilon = 1e-4;
-    desc.offset = super::desc::OffsetRule::ErrorBound;
+    desc.offset = OffsetRule::ErrorBound;
     desc.max_depth = 0;
     desc.shadows = false;
     let mut warn = Vec::new();

@@ -3,8 +3,8 @@
 //! transformations and its thin lens.
 
 use super::Reader;
-use crate::scene::tree::Node;
-use crate::scene::{CameraDesc, Lens, Window};
+use crate::scene::desc::{CameraDesc, Lens, Window};
+use crate::scene::readers::tree::Node;
 use crate::{Error, Result};
 
 impl Reader<'_> {
