@@ -17,7 +17,7 @@ use std::path::Path;
 /// Layer of each top-level module, and of each submodule of `scene` (the description, the readers, the
 /// runtime scene and the build step share that folder). Lower numbers are lower layers.
 const LAYERS: &[(&str, u32)] = &[
-    // Foundations: vectors, errors, images, meshes, sampling, exact sums.
+    // Foundations: vectors, errors, reading input files, images, meshes, sampling, exact sums.
     ("math", 0),
     ("error", 0),
     ("film", 0),
@@ -25,6 +25,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("accum", 0),
     ("image_io", 0),
     ("mesh_io", 0),
+    ("input", 0),
     // The description: plain data with source positions, and its limits.
     ("scene::desc", 1),
     ("scene::limits", 1),

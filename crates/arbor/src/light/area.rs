@@ -31,6 +31,8 @@ fn sample_area(position: Vec3, normal: Vec3, size: f32, radiance: Color, p: Vec3
     let q = position + (u.x - 0.5) * size * a + (u.y - 0.5) * size * b;
     let to_light = q - p;
     let d2 = to_light.length_squared();
+    // Negated so that a NaN distance (a NaN point) gives no light, as a zero one does.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if !(d2 > 0.0) {
         return None;
     }

@@ -16,6 +16,8 @@ impl Light for PointLight {
     fn sample(&self, p: Vec3, _u: Vec2) -> Option<LightSample> {
         let to_light = self.position - p;
         let d2 = to_light.length_squared();
+        // Negated so that a NaN distance (a NaN point) gives no light, as a zero one does.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(d2 > 0.0) {
             return None;
         }
