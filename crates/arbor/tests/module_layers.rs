@@ -82,7 +82,9 @@ struct Crate {
 fn module_of(rel: &str) -> ModPath {
     let rel = rel.trim_end_matches(".rs");
     let mut parts: ModPath = rel.split('/').map(str::to_string).collect();
-    if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
+    if matches!(parts.last().map(String::as_str), Some("mod" | "lib" | "main")) && parts.len() == 1
+        || parts.last().is_some_and(|p| p == "mod")
+    {
         parts.pop();
     }
     parts
@@ -544,7 +546,12 @@ fn layer_violations(c: &Crate) -> Vec<String> {
 }
 
 fn sources() -> BTreeMap<String, String> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    sources_of(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"))
+}
+
+/// Every `.rs` file below `src`, by its path relative to `src`.
+fn sources_of(src: &Path) -> BTreeMap<String, String> {
+    let src = src.to_path_buf();
     let mut out = BTreeMap::new();
     let mut dirs = vec![src.clone()];
     while let Some(dir) = dirs.pop() {
@@ -552,7 +559,8 @@ fn sources() -> BTreeMap<String, String> {
             let path = entry.unwrap().path();
             if path.is_dir() {
                 dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
+            } else if path.extension().is_some_and(|e| e == "rs") && !path.ends_with("tests.rs") {
+                // A `tests.rs` is a `#[cfg(test)] mod tests;`: test code, like the in-file tests left out.
                 let rel = path.strip_prefix(&src).unwrap().to_string_lossy().replace('\\', "/");
                 out.insert(rel, std::fs::read_to_string(&path).unwrap());
             }
@@ -565,6 +573,17 @@ fn sources() -> BTreeMap<String, String> {
 fn module_layers_no_cycle_among_sibling_modules() {
     let cycles = sibling_cycles(&Crate::from_sources(&sources()));
     assert!(cycles.is_empty(), "{}", cycles.join("\n"));
+}
+
+#[test]
+fn module_layers_no_cycle_in_the_other_crates_of_the_workspace() {
+    for krate in ["arbor-accel", "arbor-cli"] {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(krate).join("src");
+        let sources = sources_of(&src);
+        assert!(sources.len() > 5, "{krate}: no sources found in {}", src.display());
+        let cycles = sibling_cycles(&Crate::from_sources(&sources));
+        assert!(cycles.is_empty(), "{krate}:\n{}", cycles.join("\n"));
+    }
 }
 
 #[test]

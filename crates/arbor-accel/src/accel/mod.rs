@@ -36,7 +36,7 @@ pub use brute::BruteForce;
 #[doc(hidden)]
 pub use bvh::Bvh;
 pub use bvh::{BottomUpMethod, BottomUpParams, BvhParams, MedianParams, MergeCost};
-pub use config::{AccelConfig, ConfigError, KindParam};
+pub use config::{AccelConfig, KindParam};
 #[doc(hidden)]
 pub use kdtree::KdTree;
 pub use kdtree::KdTreeParams;
@@ -45,7 +45,7 @@ pub use octree::Octree;
 pub use octree::OctreeParams;
 #[doc(hidden)]
 pub use params::ParamSet;
-pub use params::{ParamRange, ParamSpec, ParamValue};
+pub use params::{ConfigError, ParamRange, ParamSpec, ParamValue};
 pub use structure::{Structure, ValidateError};
 
 /// How much every structure widens its box and interval tests, relative to the extent in `t` of the box

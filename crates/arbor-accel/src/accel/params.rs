@@ -5,7 +5,6 @@
 
 use std::fmt;
 
-use super::config::ConfigError;
 use super::AccelKind;
 
 /// The values a parameter accepts. Bounds are inclusive.
@@ -188,6 +187,81 @@ pub(crate) fn check(params: &dyn ParamSet) -> Result<(), ConfigError> {
     }
     Ok(())
 }
+
+/// What is wrong with a structure's name or parameters.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// No structure has this name.
+    UnknownKind {
+        /// The name given.
+        name: String,
+    },
+    /// The structure has no parameter of this key.
+    UnknownParam {
+        /// The structure.
+        kind: AccelKind,
+        /// The key given.
+        key: String,
+    },
+    /// A parameter was not written `KEY=VALUE`.
+    NotKeyValue {
+        /// The text given.
+        text: String,
+    },
+    /// A parameter was not written `KIND:KEY=VALUE`.
+    NotKindKeyValue {
+        /// The text given.
+        text: String,
+    },
+    /// The value does not read as the parameter's type (not a number, not one of its words).
+    BadValue {
+        /// The parameter.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it accepts.
+        range: ParamRange,
+    },
+    /// The value reads but lies outside the parameter's range.
+    OutOfRange {
+        /// The parameter.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it accepts.
+        range: ParamRange,
+    },
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ConfigError::UnknownKind { name } => {
+                let names: Vec<_> = AccelKind::ALL.iter().map(|k| k.name()).collect();
+                write!(f, "unknown acceleration structure '{name}' (expected one of: {})", names.join(", "))
+            }
+            ConfigError::UnknownParam { kind, key } => {
+                let keys: Vec<_> = kind.params().iter().map(|s| s.key).collect();
+                if keys.is_empty() {
+                    write!(f, "{kind} takes no parameters (got '{key}')")
+                } else {
+                    write!(f, "{kind} has no parameter '{key}' (it has: {})", keys.join(", "))
+                }
+            }
+            ConfigError::NotKeyValue { text } => write!(f, "'{text}' is not KEY=VALUE"),
+            ConfigError::NotKindKeyValue { text } => write!(f, "'{text}' is not KIND:KEY=VALUE"),
+            ConfigError::BadValue { key, value, range } => {
+                write!(f, "parameter '{key}': cannot read '{value}' (expected {range})")
+            }
+            ConfigError::OutOfRange { key, value, range } => {
+                write!(f, "parameter '{key}': {value} is outside its range {range}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ConfigError {}
 
 #[cfg(test)]
 mod tests {
