@@ -23,6 +23,7 @@ mod mesh_prims;
 #[doc(hidden)]
 pub mod octree;
 mod params;
+mod stats;
 mod structure;
 
 use std::fmt;

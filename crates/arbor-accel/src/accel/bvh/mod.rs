@@ -41,6 +41,7 @@ pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 pub use params::{BvhParams, MedianParams};
 pub use wide::{Node8, Wide};
 
+use super::stats::StatsTally;
 use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
@@ -168,19 +169,13 @@ impl Bvh {
     }
 
     fn compute_stats(&self, kind: &'static str, build_time: Duration) -> AccelStats {
-        let mut stats = AccelStats {
-            kind,
-            primitives: self.prim_indices.len(),
-            nodes: self.nodes.len(),
-            bytes: std::mem::size_of::<Self>()
-                + self.nodes.len() * std::mem::size_of::<Node>()
-                + self.prim_indices.len() * std::mem::size_of::<u32>()
-                + self.wide.bytes(),
-            build_time,
-            ..AccelStats::default()
-        };
+        let bytes = std::mem::size_of::<Self>()
+            + self.nodes.len() * std::mem::size_of::<Node>()
+            + self.prim_indices.len() * std::mem::size_of::<u32>()
+            + self.wide.bytes();
+        let mut tally = StatsTally::new(kind, self.prim_indices.len(), self.nodes.len(), bytes, build_time);
         let Some(root) = self.nodes.first() else {
-            return stats;
+            return tally.finish();
         };
         // Areas relative to the root's; a root of zero area (all primitives on one line or point)
         // makes every node equally likely to be visited.
@@ -192,27 +187,18 @@ impl Bvh {
                 1.0
             }
         };
-        let mut leaf_prims = 0usize;
-        let mut depth_sum = 0usize;
         let mut stack = vec![(0usize, 0usize)];
         while let Some((i, depth)) = stack.pop() {
             let n = &self.nodes[i];
-            stats.max_depth = stats.max_depth.max(depth);
             if n.is_leaf() {
-                stats.leaves += 1;
-                depth_sum += depth;
-                leaf_prims += n.count as usize;
-                stats.sah_cost += rel(n) * n.count as f64;
+                tally.leaf(depth, n.count as usize, rel(n));
             } else {
-                stats.sah_cost += rel(n);
+                tally.inner(rel(n));
                 stack.push((i + 1, depth + 1));
                 stack.push((n.offset as usize, depth + 1));
             }
         }
-        stats.mean_leaf_prims = leaf_prims as f64 / stats.leaves as f64;
-        stats.mean_depth = depth_sum as f64 / stats.leaves as f64;
-        stats.refs_per_prim = if stats.primitives > 0 { leaf_prims as f64 / stats.primitives as f64 } else { 0.0 };
-        stats
+        tally.finish()
     }
 }
 

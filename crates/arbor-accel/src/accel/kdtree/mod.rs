@@ -37,6 +37,7 @@ mod tests;
 use std::time::{Duration, Instant};
 
 use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
+use super::stats::StatsTally;
 use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray};
 
@@ -272,42 +273,21 @@ impl KdTree {
     }
 
     fn compute_stats(&self, build_time: Duration) -> AccelStats {
-        let mut stats = AccelStats {
-            kind: "kdtree",
-            primitives: self.len,
-            nodes: self.nodes.len(),
-            bytes: std::mem::size_of::<Self>()
-                + self.nodes.len() * std::mem::size_of::<Node>()
-                + self.refs.len() * std::mem::size_of::<u32>(),
-            build_time,
-            ..AccelStats::default()
-        };
+        let bytes = std::mem::size_of::<Self>()
+            + self.nodes.len() * std::mem::size_of::<Node>()
+            + self.refs.len() * std::mem::size_of::<u32>();
+        let mut tally = StatsTally::new("kdtree", self.len, self.nodes.len(), bytes, build_time);
         let root_area = self.bounds.area_f64();
-        let (mut refs, mut depth_sum, mut non_empty) = (0usize, 0usize, 0usize);
         self.walk(|_, n, b, depth| {
             // A flat or degenerate root makes every node equally likely to be visited.
             let p = if root_area > 0.0 { b.area_f64() / root_area } else { 1.0 };
             if n.is_leaf() {
-                stats.leaves += 1;
-                stats.max_depth = stats.max_depth.max(depth);
-                depth_sum += depth;
-                refs += n.count();
-                non_empty += (n.count() > 0) as usize;
-                stats.sah_cost += p * n.count() as f64;
+                tally.leaf(depth, n.count(), p);
             } else {
-                stats.sah_cost += p;
+                tally.inner(p);
             }
         });
-        if stats.leaves > 0 {
-            stats.mean_depth = depth_sum as f64 / stats.leaves as f64;
-        }
-        if non_empty > 0 {
-            stats.mean_leaf_prims = refs as f64 / non_empty as f64;
-        }
-        if self.len > 0 {
-            stats.refs_per_prim = refs as f64 / self.len as f64;
-        }
-        stats
+        tally.finish()
     }
 
     /// Checks the invariants listed in the module docs.

@@ -32,6 +32,7 @@ mod validate;
 use std::time::{Duration, Instant};
 
 use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
+use super::stats::StatsTally;
 use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
@@ -262,41 +263,21 @@ impl Octree {
     }
 
     fn compute_stats(&self, build_time: Duration) -> AccelStats {
-        let mut stats = AccelStats {
-            kind: "octree",
-            primitives: self.len,
-            nodes: self.nodes.len(),
-            bytes: std::mem::size_of::<Self>()
-                + self.nodes.len() * std::mem::size_of::<Node>()
-                + self.refs.len() * std::mem::size_of::<u32>(),
-            build_time,
-            ..AccelStats::default()
-        };
-        let (mut full_leaves, mut depth_sum) = (0usize, 0usize);
+        let bytes = std::mem::size_of::<Self>()
+            + self.nodes.len() * std::mem::size_of::<Node>()
+            + self.refs.len() * std::mem::size_of::<u32>();
+        let mut tally = StatsTally::new("octree", self.len, self.nodes.len(), bytes, build_time);
         // Octants have a quarter of their parent's area, so a cell at depth `d` is hit by a fraction
         // 4^-d of the rays that hit the root.
         self.for_each_cell(|node, _, depth| {
-            let rel = 0.25f64.powi(depth as i32);
-            stats.max_depth = stats.max_depth.max(depth);
+            let p = 0.25f64.powi(depth as i32);
             if node.is_leaf() {
-                stats.leaves += 1;
-                stats.sah_cost += rel * node.count as f64;
-                if node.count > 0 {
-                    full_leaves += 1;
-                    depth_sum += depth;
-                }
+                tally.leaf(depth, node.count as usize, p);
             } else {
-                stats.sah_cost += rel;
+                tally.inner(p);
             }
         });
-        if full_leaves > 0 {
-            stats.mean_leaf_prims = self.refs.len() as f64 / full_leaves as f64;
-            stats.mean_depth = depth_sum as f64 / full_leaves as f64;
-        }
-        if self.len > 0 {
-            stats.refs_per_prim = self.refs.len() as f64 / self.len as f64;
-        }
-        stats
+        tally.finish()
     }
 }
 
