@@ -2,10 +2,11 @@
 //! refused with "not enough memory for a WxH image (N GiB)" (exit 4) instead of dying of an allocation
 //! failure at its end with the work lost.
 //!
-//! The renderer allocates its buffers as it goes; this reserves their total once, fallibly
-//! (`try_reserve_exact`), and gives it back: under an address-space limit (`ulimit -v`, a batch
-//! system's memory limit) or beyond what the system will commit, the reservation fails exactly where
-//! the render would have. Per pixel of the window: the exact sample sums (48 bytes: three i128), the
+//! The renderer allocates its own large buffers fallibly (the film and the sums before tracing, each
+//! tile's sums as it goes: `arbor::Error::OutOfMemory`); this reserves their total peak once, before
+//! the render, and gives it back: under an address-space limit (`ulimit -v`, a batch system's memory
+//! limit) or beyond what the system will commit, the reservation fails where the render would have,
+//! and the message gives the whole image's need rather than one buffer's. Per pixel of the window: the exact sample sums (48 bytes: three i128), the
 //! film in linear RGB (12 bytes; for a plain render one of the full frame too, as debug overlays are
 //! drawn in frame coordinates), and the encoded output with its 8-bit or float copy (at most 28 bytes).
 

@@ -224,7 +224,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 crate::memory::reserve_for(cam.width, cam.height, window, true)?;
                 let bar = Progress::new(args.quiet > 0, pixels(opts.crop, cam.width, cam.height), &cam.image_name);
                 signals.check()?;
-                let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total));
+                let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 signals.check()?;
                 let window = sums.window;
@@ -236,7 +236,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 crate::memory::reserve_for(cam.width, cam.height, window, false)?;
                 let bar = Progress::new(args.quiet > 0, pixels(base.crop, cam.width, cam.height), &cam.image_name);
                 signals.check()?;
-                let (film, stats) = render(&scene, c, &base, &|done, total| bar.set(done, total));
+                let (film, stats) = render(&scene, c, &base, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;

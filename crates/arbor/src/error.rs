@@ -70,6 +70,9 @@ pub enum Error {
     /// A request that makes no sense independently of any file (bad option value, empty scene...).
     #[error("{0}")]
     Invalid(String),
+    /// A buffer the work needs could not be allocated (the message says which and how large).
+    #[error("{0}")]
+    OutOfMemory(String),
 }
 
 impl Error {
@@ -81,9 +84,10 @@ impl Error {
     pub fn io(path: impl AsRef<Path>, source: std::io::Error) -> Self {
         Error::Io { path: path.as_ref().to_path_buf(), source }
     }
-    /// True when the failure is the file system's rather than the input's (CLI exit code 4 vs 3).
+    /// True when the failure is the machine's (file system, memory) rather than the input's (CLI exit code 4
+    /// vs 3).
     pub fn is_io(&self) -> bool {
-        matches!(self, Error::Io { .. })
+        matches!(self, Error::Io { .. } | Error::OutOfMemory(_))
     }
 }
 

@@ -1,5 +1,6 @@
 //! The film: a width x height grid of linear RGB in display units (1.0 = white), row 0 at the top.
 
+use crate::error::{Error, Result};
 use crate::math::Color;
 
 /// A rendered image before it is written.
@@ -18,6 +19,17 @@ impl Film {
     pub fn new(width: u32, height: u32) -> Self {
         Film { width, height, pixels: vec![Color::ZERO; width as usize * height as usize] }
     }
+    /// A black film, or [`Error::OutOfMemory`] when its pixels cannot be allocated: a film large
+    /// enough to fail is asked for before its render, not after.
+    pub fn try_new(width: u32, height: u32) -> Result<Self> {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::new();
+        if pixels.try_reserve_exact(n).is_err() {
+            return Err(out_of_memory(width, height, n as u64 * std::mem::size_of::<Color>() as u64));
+        }
+        pixels.resize(n, Color::ZERO);
+        Ok(Film { width, height, pixels })
+    }
     /// The pixel at column `x`, row `y`.
     #[inline]
     pub fn get(&self, x: u32, y: u32) -> Color {
@@ -28,6 +40,12 @@ impl Film {
     pub fn to_rgb8(&self) -> Vec<u8> {
         self.pixels.iter().flat_map(|c| c.to_array()).map(quantize).collect()
     }
+}
+
+/// The error for buffers of `bytes` for a `width` x `height` image that could not be allocated.
+pub fn out_of_memory(width: u32, height: u32, bytes: u64) -> Error {
+    let gib = bytes as f64 / (1u64 << 30) as f64;
+    Error::OutOfMemory(format!("not enough memory for a {width}x{height} image ({gib:.1} GiB)"))
 }
 
 /// One channel to 8 bits: clamp, scale, round half up. NaN becomes 0.

@@ -25,7 +25,8 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use crate::accum::SampleSum;
-use crate::film::Film;
+use crate::error::Result;
+use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
 use crate::integrator::{DebugIntegrator, DebugView, Whitted};
 use crate::sampler::{pixel_offset, Rng};
@@ -80,19 +81,20 @@ impl RenderStats {
 }
 
 /// Renders camera `camera` of `scene`. `progress(done, total)` is called (from worker threads) as pixels
-/// complete.
+/// complete. Fails only when the image's buffers cannot be allocated ([`crate::Error::OutOfMemory`]), before
+/// any ray is traced for the film, or during tracing for the tiles' sums.
 pub fn render(
     scene: &Scene,
     camera: usize,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
-) -> (Film, RenderStats) {
+) -> Result<(Film, RenderStats)> {
     let cam = &scene.cameras[camera];
     let (w, h) = (cam.width, cam.height);
-    let (traced, stats, scale) = trace(scene, camera, opts, progress);
-    let count = stats.samples.1 - stats.samples.0;
     // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
-    let mut film = Film::new(w, h);
+    let mut film = Film::try_new(w, h)?;
+    let (traced, stats, scale) = trace(scene, camera, opts, progress)?;
+    let count = stats.samples.1 - stats.samples.0;
     for ((x0, y0, tw), sums) in traced {
         for (k, s) in sums.into_iter().enumerate() {
             let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
@@ -111,7 +113,7 @@ pub fn render(
     if (cx0, cy0, cx1, cy1) != (0, 0, w, h) {
         film = cut(&film, cx0, cy0, cx1, cy1);
     }
-    (film, RenderStats { heatmap_max, ..stats })
+    Ok((film, RenderStats { heatmap_max, ..stats }))
 }
 
 /// The exact sample sums of one render's window, for a partial image that `arbor merge` combines.
@@ -138,13 +140,14 @@ pub fn render_sums(
     camera: usize,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
-) -> (RenderSums, RenderStats) {
+) -> Result<(RenderSums, RenderStats)> {
     let opts = RenderOptions { debug: None, ..opts.clone() };
     let cam = &scene.cameras[camera];
     let window = crop_window(opts.crop, cam.width, cam.height);
-    let (traced, stats, scale) = trace(scene, camera, &opts, progress);
     let ww = (window.2 - window.0) as usize;
-    let mut sums = vec![SampleSum::default(); ww * (window.3 - window.1) as usize];
+    let mut sums = sums_buffer(window)?;
+    sums.resize(ww * (window.3 - window.1) as usize, SampleSum::default());
+    let (traced, stats, scale) = trace(scene, camera, &opts, progress)?;
     for ((x0, y0, tw), tile) in traced {
         for (k, s) in tile.into_iter().enumerate() {
             let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
@@ -152,8 +155,22 @@ pub fn render_sums(
         }
     }
     let frame = (cam.width, cam.height);
-    (RenderSums { frame, window, spp: stats.spp, samples: stats.samples, scale, sums }, stats)
+    Ok((RenderSums { frame, window, spp: stats.spp, samples: stats.samples, scale, sums }, stats))
 }
+
+/// An empty buffer with room for the sums of `window`'s pixels, or [`crate::Error::OutOfMemory`].
+fn sums_buffer(window: (u32, u32, u32, u32)) -> Result<Vec<SampleSum>> {
+    let (w, h) = (window.2 - window.0, window.3 - window.1);
+    let n = w as usize * h as usize;
+    let mut sums = Vec::new();
+    match sums.try_reserve_exact(n) {
+        Ok(()) => Ok(sums),
+        Err(_) => Err(out_of_memory(w, h, n as u64 * std::mem::size_of::<SampleSum>() as u64)),
+    }
+}
+
+/// Bytes of one pixel's exact sample sums.
+const SUM_BYTES: u64 = std::mem::size_of::<SampleSum>() as u64;
 
 /// Per-tile sums over the crop window: `((x0, y0, tile width), sums)`, the stats and the radiance scale.
 type Traced = Vec<((u32, u32, u32), Vec<SampleSum>)>;
@@ -163,7 +180,7 @@ fn trace(
     camera: usize,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
-) -> (Traced, RenderStats, f32) {
+) -> Result<(Traced, RenderStats, f32)> {
     let start = Instant::now();
     let cam = &scene.cameras[camera];
     let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
@@ -188,11 +205,13 @@ fn trace(
     let rays = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
 
-    let traced: Traced = tiles
+    let traced: Result<Traced> = tiles
         .par_iter()
         .filter(|_| !is_cancelled())
         .map(|&(x0, y0, x1, y1)| {
-            let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            // Every tile's sums are kept until the image is assembled: together, one per pixel.
+            let mut pixels =
+                sums_buffer((x0, y0, x1, y1)).map_err(|_| out_of_memory(cx1 - cx0, cy1 - cy0, total * SUM_BYTES))?;
             let mut count = 0u64;
             let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
@@ -235,9 +254,10 @@ fn trace(
             rays.fetch_add(count, Ordering::Relaxed);
             let n = done.fetch_add(pixels.len() as u64, Ordering::Relaxed) + pixels.len() as u64;
             progress(n, total);
-            ((x0, y0, x1 - x0), pixels)
+            Ok(((x0, y0, x1 - x0), pixels))
         })
         .collect();
+    let traced = traced?;
     let cancelled = is_cancelled();
     let stats = RenderStats {
         rays: rays.into_inner(),
@@ -247,7 +267,7 @@ fn trace(
         heatmap_max: None,
         cancelled,
     };
-    (traced, stats, scale)
+    Ok((traced, stats, scale))
 }
 
 /// The crop window clamped to a `w` x `h` frame, as `(x0, y0, x1, y1)` with `x0 < x1`, `y0 < y1` unless the

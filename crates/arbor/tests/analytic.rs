@@ -68,7 +68,7 @@ fn scene(materials: Vec<MaterialDesc>, objects: Vec<ObjectDesc>, lights: Vec<Lig
 
 fn pixel(desc: SceneDesc) -> Color {
     let s = Scene::build(desc, &AccelConfig::default(), None).unwrap();
-    let (film, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
+    let (film, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
     film.pixels[0]
 }
 
@@ -166,7 +166,7 @@ fn analytic_render_is_identical_for_any_thread_count() {
     let s = Scene::build(desc, &AccelConfig::default(), None).unwrap();
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| render(&s, 0, &RenderOptions::default(), &|_, _| {}).0)
+        pool.install(|| render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0)
     };
     assert_eq!(run(1).pixels, run(3).pixels);
 }
@@ -189,13 +189,13 @@ fn analytic_environment_seen_directly_and_in_a_mirror() {
     let mut desc = scene(vec![], vec![], vec![], 0);
     desc.radiance_scale = 1.0 / 255.0;
     let s = Scene::build(desc, &AccelConfig::default(), env()).unwrap();
-    let (direct, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
+    let (direct, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
     assert_close(direct.pixels[0], Color::new(0.8, 0.0, 0.0));
     // A mirror facing the camera sends the ray back along +z: blue, times the mirror's reflectance.
     let mirror = material(0.0, 0.0, MaterialKind::Mirror { reflectance: Color::splat(0.5) });
     let desc = scene(vec![mirror], vec![object(quad(0.0, 5.0, true), 0)], vec![], 1);
     let s = Scene::build(desc, &AccelConfig::default(), env()).unwrap();
-    let (reflected, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {});
+    let (reflected, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
     assert_close(reflected.pixels[0], Color::new(0.0, 0.0, 0.3));
 }
 
@@ -225,4 +225,20 @@ fn analytic_scene_without_shadows_lights_occluded_points() {
     desc.cameras[0].position = Vec3::new(0.0, 0.0, 3.0);
     desc.shadows = false;
     assert_close(pixel(desc), Color::splat(25.0 + 0.5 * 1600.0 / 16.0));
+}
+
+#[test]
+fn render_refuses_an_image_too_large_for_memory_before_tracing() {
+    let mut desc = scene(vec![material(1.0, 0.0, MaterialKind::BlinnPhong)], vec![], vec![], 0);
+    (desc.cameras[0].width, desc.cameras[0].height) = (4_000_000, 4_000_000);
+    let s = Scene::build(desc, &AccelConfig::default(), None).unwrap();
+    let traced = std::sync::atomic::AtomicBool::new(false);
+    let progress = |_: u64, _: u64| traced.store(true, std::sync::atomic::Ordering::Relaxed);
+    // 1.6e13 pixels: 12 bytes each in the film, 48 in the exact sums.
+    let e = render(&s, 0, &RenderOptions::default(), &progress).unwrap_err();
+    assert_eq!(e.to_string(), "not enough memory for a 4000000x4000000 image (178813.9 GiB)");
+    let e = arbor::render::render_sums(&s, 0, &RenderOptions::default(), &progress).unwrap_err();
+    assert_eq!(e.to_string(), "not enough memory for a 4000000x4000000 image (715255.7 GiB)");
+    assert!(e.is_io(), "exit 4, as the other resources the machine lacks");
+    assert!(!traced.into_inner(), "refused before any tile was traced");
 }

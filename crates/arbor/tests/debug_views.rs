@@ -24,7 +24,7 @@ const WORK_BUDGET: f64 = 1e8;
 fn debug_render(desc: &SceneDesc, kind: AccelKind, view: DebugView) -> (Film, Option<u32>) {
     let scene = Scene::build(desc.clone(), &AccelConfig::from(kind), None).unwrap_or_else(|e| panic!("{e}"));
     let opts = RenderOptions { debug: Some(view), ..Default::default() };
-    let (film, stats) = render(&scene, 0, &opts, &|_, _| {});
+    let (film, stats) = render(&scene, 0, &opts, &|_, _| {}).unwrap();
     (film, stats.heatmap_max)
 }
 
@@ -116,7 +116,7 @@ fn debug_primid_identical_across_structures_on_reference_scenes() {
                 continue;
             }
             let opts = RenderOptions { debug: Some(DebugView::PrimId), ..Default::default() };
-            let (film, _) = render(&scene, 0, &opts, &|_, _| {});
+            let (film, _) = render(&scene, 0, &opts, &|_, _| {}).unwrap();
             if film.to_rgb8() != bytes {
                 failures.push(format!("{kind} on {}", path.display()));
             }

@@ -27,7 +27,7 @@ fn examples_load_build_and_render() {
             (cam.width, cam.height) = (cam.width / 8, cam.height / 8);
         }
         let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
-        let (film, _) = render(&scene, 0, &RenderOptions::default(), &|_, _| {});
+        let (film, _) = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
         let lit = film.pixels.iter().filter(|c| c.max_element() > 0.1).count();
         assert!(lit * 4 > film.pixels.len(), "{}: mostly dark", path.display());
         seen += 1;

@@ -30,7 +30,7 @@ fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)
     let cam = &scene.cameras[0];
     let crop = tile.map(|(i, n)| tile_window(i, n, cam.width, cam.height).unwrap());
     let opts = RenderOptions { crop, samples: Some(samples), ..Default::default() };
-    let (sums, stats) = render_sums(scene, 0, &opts, &|_, _| {});
+    let (sums, stats) = render_sums(scene, 0, &opts, &|_, _| {}).unwrap();
     assert_eq!(stats.samples, samples);
     let name = format!("part-{:?}-{}-{}.exr", tile.unwrap_or((0, 1)), samples.0, samples.1);
     let path = dir.join(name);
@@ -45,7 +45,7 @@ fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)
 fn farm_tiles_and_sample_ranges_merge_to_the_whole() {
     let scene = example();
     let dir = tempfile::tempdir().unwrap();
-    let whole = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).0;
+    let whole = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0;
     let splits: [&[(u32, u32)]; 4] =
         [&[(0, 4)], &[(0, 1), (1, 4)], &[(2, 4), (0, 2)], &[(3, 4), (0, 1), (2, 3), (1, 2)]];
     for n in [1, 4, 9] {

@@ -209,7 +209,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             loc: Location::file("test"),
         });
         let s = Scene::build(d, &AccelConfig::default(), None).unwrap();
-        images.push(render(&s, 0, &RenderOptions::default(), &|_, _| {}).0);
+        images.push(render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0);
     }
     let lit = images[1].pixels.iter().filter(|c| c.x > 0.05).count();
     assert!(lit > 200, "only {lit} lit pixels: the test sees too little of the sphere");

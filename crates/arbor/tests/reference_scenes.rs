@@ -55,7 +55,7 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>) -> (String, Vec<Stri
         let scene = &current.as_ref().unwrap().1;
         let start = Instant::now();
         let opts = RenderOptions { cull_backfaces: Some(case.cull), ..Default::default() };
-        let (film, _) = render(scene, case.camera, &opts, &|_, _| {});
+        let (film, _) = render(scene, case.camera, &opts, &|_, _| {}).unwrap();
         let secs = start.elapsed().as_secs_f64();
         let name = case.scene.file_name().unwrap().to_string_lossy().to_string();
         let image = case.reference.file_name().unwrap().to_string_lossy().to_string();

@@ -29,7 +29,7 @@ fn shrink(mut desc: SceneDesc, divisor: u32) -> SceneDesc {
 
 fn render_on(threads: usize, scene: &Scene, camera: usize, opts: &RenderOptions) -> Film {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| render(scene, camera, opts, &|_, _| {}).0)
+    pool.install(|| render(scene, camera, opts, &|_, _| {}).unwrap().0)
 }
 
 fn bits(film: &Film) -> Vec<u32> {
@@ -151,7 +151,7 @@ fn reproducible_render_stops_when_cancelled() {
     let scene = example();
     let cancel = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
     let opts = RenderOptions { cancel: Some(cancel), ..Default::default() };
-    let (film, stats) = render(&scene, 0, &opts, &|_, _| {});
+    let (film, stats) = render(&scene, 0, &opts, &|_, _| {}).unwrap();
     assert!(stats.cancelled);
     assert_eq!(stats.rays, 0);
     assert!(film.pixels.iter().all(|c| *c == arbor::math::Color::ZERO));
