@@ -9,6 +9,14 @@
 //! equals it).
 
 use super::Hit;
+use crate::math::Ray;
+
+/// True when no query can hit anything: an invalid ray (NaN or zero direction) or an empty
+/// `(0, t_max)`. Every structure asks this before its traversal.
+#[inline]
+pub(crate) fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
+    !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
+}
 
 /// The closest hit so far of one query in `(0, t_max)`.
 #[derive(Debug, Clone, Copy)]

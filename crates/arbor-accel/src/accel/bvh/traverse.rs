@@ -27,7 +27,7 @@
 #[cfg(test)]
 use super::{Node, MAX_DEPTH};
 #[cfg(test)]
-use crate::accel::closest::ClosestHit;
+use crate::accel::closest::{trivially_misses, ClosestHit};
 #[cfg(test)]
 use crate::accel::{Hit, Primitives, TraversalCounts};
 #[cfg(test)]
@@ -99,13 +99,6 @@ impl RayBoxTest {
 }
 
 #[cfg(test)]
-/// True when no structure query can hit anything: invalid ray, empty tree, or an empty `(0, t_max)`.
-#[inline]
-fn trivially_misses(nodes: &[Node], ray: &Ray, t_max: f32) -> bool {
-    nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
-}
-
-#[cfg(test)]
 /// The closest hit in `(0, t_max)`, ties to the lowest primitive index. With `COUNT`, the nodes visited
 /// and primitives tested are added to `counts` (compiled out otherwise).
 pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
@@ -116,7 +109,7 @@ pub(crate) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    if trivially_misses(nodes, ray, t_max) {
+    if nodes.is_empty() || trivially_misses(ray, t_max) {
         return None;
     }
     let test = RayBoxTest::new(ray);
@@ -167,7 +160,7 @@ pub(crate) fn occluded<P: Primitives + ?Sized>(
     ray: &Ray,
     t_max: f32,
 ) -> bool {
-    if trivially_misses(nodes, ray, t_max) {
+    if nodes.is_empty() || trivially_misses(ray, t_max) {
         return false;
     }
     let test = RayBoxTest::new(ray);

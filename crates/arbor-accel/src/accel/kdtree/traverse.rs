@@ -24,7 +24,7 @@
 //! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 
 use super::{KdTree, MAX_DEPTH};
-use crate::accel::closest::ClosestHit;
+use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
@@ -51,7 +51,7 @@ struct Clipped {
 impl Clipped {
     /// The ray's interval in the root box within `(0, t_max)`, or `None` when nothing can be hit.
     fn new(tree: &KdTree, ray: &Ray, t_max: f32) -> Option<Self> {
-        if tree.nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0 {
+        if tree.nodes.is_empty() || trivially_misses(ray, t_max) {
             return None;
         }
         let (origin, dir, inv_dir) = (ray.origin.to_array(), ray.dir.to_array(), ray.inv_dir.to_array());

@@ -27,7 +27,7 @@
 //! the stack.
 
 use super::{child_box, split_point, Octree, MAX_DEPTH};
-use crate::accel::closest::ClosestHit;
+use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::{Aabb, Ray, Vec3};
 
@@ -127,7 +127,7 @@ pub(super) fn traverse<P: Primitives + ?Sized, const COUNT: bool, const ANY: boo
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
     let (nodes, refs) = (&tree.nodes, &tree.refs);
-    if nodes.is_empty() || !ray.is_valid() || t_max.is_nan() || t_max <= 0.0 {
+    if nodes.is_empty() || trivially_misses(ray, t_max) {
         return None;
     }
     let rc = RayCells::new(ray, &tree.root);

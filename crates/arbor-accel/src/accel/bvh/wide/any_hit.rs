@@ -3,11 +3,12 @@
 
 use std::mem::MaybeUninit;
 
-use super::dispatch::{run_with, trivially_misses, Traversal};
+use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
 use super::leaves::{LeafRay, Leaves};
 use super::visit::STACK;
 use super::{Node8, Ref, Wide};
+use crate::accel::closest::trivially_misses;
 use crate::accel::Primitives;
 use crate::math::Ray;
 

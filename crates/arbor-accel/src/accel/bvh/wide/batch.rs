@@ -5,12 +5,12 @@
 //! same nodes and gets the same hit as it would alone. The counted query and the any-hit query stay
 //! one ray at a time.
 
-use super::dispatch::{run_with, trivially_misses, Traversal};
+use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
 use super::leaves::{LeafRay, Leaves};
 use super::visit::{new_stack, pop, visit, Stack};
 use super::{Node8, Ref, Wide};
-use crate::accel::closest::ClosestHit;
+use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 

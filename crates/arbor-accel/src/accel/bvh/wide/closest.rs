@@ -6,12 +6,12 @@
 //! (`visit.rs`), and leaves ask for hits up to the float above the best `t` and keep ties by lowest
 //! primitive index (`leaves.rs`).
 
-use super::dispatch::{run_with, trivially_misses, Traversal};
+use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
 use super::leaves::{LeafRay, Leaves};
 use super::visit::{new_stack, pop, visit};
 use super::{Node8, Ref, Wide};
-use crate::accel::closest::ClosestHit;
+use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 

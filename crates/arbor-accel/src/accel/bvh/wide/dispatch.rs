@@ -11,7 +11,6 @@ use super::kernel::{Kernel, NodeTest, Scalar};
 use super::leaves::{Leaves, MeshLeaves, PrimLeaves};
 use super::{Node8, Ref, Wide};
 use crate::accel::Primitives;
-use crate::math::Ray;
 
 /// A traversal of the tree, compiled once per kernel and kind of leaf by [`run_with`].
 pub(super) trait Traversal {
@@ -62,10 +61,4 @@ fn run_kernel<P: Primitives + ?Sized, T: Traversal, K: NodeTest>(
         Some(blocks) => t.run(kernel, &wide.nodes, &MeshLeaves { blocks }, root),
         None => t.run(kernel, &wide.nodes, &PrimLeaves { indices, prims }, root),
     }
-}
-
-/// True when no query can hit anything: invalid ray or an empty `(0, t_max)`.
-#[inline]
-pub(super) fn trivially_misses(ray: &Ray, t_max: f32) -> bool {
-    !ray.is_valid() || t_max.is_nan() || t_max <= 0.0
 }
