@@ -37,8 +37,7 @@ enum Base {
 impl Reader<'_> {
     /// Every object of `Objects`, in file order, then the instances' bases.
     pub(super) fn objects(&mut self, objects: &Node) -> Result<()> {
-        let mut mesh_ids: HashMap<String, Base> = HashMap::new();
-        let mut instance_ids: HashMap<String, Base> = HashMap::new();
+        let mut ids: HashMap<String, Base> = HashMap::new();
         let mut pending = Vec::new();
         for o in &objects.children {
             let kind = o.name.as_str();
@@ -77,23 +76,16 @@ impl Reader<'_> {
                 "MeshInstance" => Some(Base::Instance(pending.len() - 1)),
                 _ => None,
             };
-            match (&id, base) {
-                (Some(id), Some(base @ Base::Mesh(_))) => {
-                    mesh_ids.insert(id.clone(), base);
+            // Before 2022 meshes and instances were numbered apart ("MeshInstance 1" of "Mesh 1"); since,
+            // one id space holds both. A mesh of the id is the base whenever there is one.
+            if let (Some(id), Some(base)) = (&id, base) {
+                if matches!(base, Base::Mesh(_)) || !matches!(ids.get(id), Some(Base::Mesh(_))) {
+                    ids.insert(id.clone(), base);
                 }
-                (Some(id), Some(base)) => {
-                    instance_ids.insert(id.clone(), base);
-                }
-                _ => {}
             }
             self.desc.objects.push(ObjectDesc { name, material, shape, transform, loc: o.loc(self.path) });
         }
-        // Before 2022 meshes and instances were numbered apart ("MeshInstance 1" of "Mesh 1"); since,
-        // one id space holds both. A mesh of the id is the base when there is one.
-        for (id, base) in instance_ids {
-            mesh_ids.entry(id).or_insert(base);
-        }
-        self.resolve_instances(&pending, &mesh_ids)
+        self.resolve_instances(&pending, &ids)
     }
 
     /// Gives every pending instance its mesh, and its base's transform and material where it asks for
