@@ -227,7 +227,6 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 signals.check()?;
-                let window = sums.window;
                 signals.writing(|| write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), sums }))?;
                 (target, stats, window)
             }
