@@ -177,6 +177,12 @@ fn hardening_pipes_and_devices_are_refused_not_read() {
     assert_eq!((o.status.code(), stderr(&o)), (Some(4), "error: sky.exr: not a regular file (a named pipe)\n".into()));
     let o = arbor(&["diff", "sky.exr", "zero.ply"], tmp.path());
     assert_eq!((o.status.code(), stderr(&o)), (Some(4), "error: sky.exr: not a regular file (a named pipe)\n".into()));
+    // The scene file and the partials of a merge, named on the command line.
+    mkfifo(&tmp.path().join("pipe.xml"));
+    let o = arbor(&["render", "pipe.xml", "-o", "out"], tmp.path());
+    assert_eq!((o.status.code(), stderr(&o)), (Some(4), "error: pipe.xml: not a regular file (a named pipe)\n".into()));
+    let o = arbor(&["merge", "sky.exr", "-o", "out/m.png"], tmp.path());
+    assert_eq!((o.status.code(), stderr(&o)), (Some(4), "error: sky.exr: not a regular file (a named pipe)\n".into()));
     assert!(!tmp.path().join("out").exists());
 }
 

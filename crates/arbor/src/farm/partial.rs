@@ -71,7 +71,7 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
 
 /// Reads a partial image written by [`write_partial`].
 pub fn read_partial(path: &Path) -> Result<Partial> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input::load_bytes(path)?;
     let bad = |msg: String| Error::input(Location::file(path), msg);
     let image = read()
         .no_deep_data()

@@ -19,7 +19,7 @@ use crate::{Error, Location, Result};
 /// Reads a scene file of any supported format: `.xml` (METU), `.json` (METU 2025 form, or the NYU
 /// `scene.json` form, told apart by their top-level keys).
 pub fn load_desc(path: &Path) -> Result<SceneDesc> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::input::load_bytes(path)?;
     let text = String::from_utf8(bytes)
         .map_err(|e| Error::input(Location::byte(path, e.utf8_error().valid_up_to() as u64), "not UTF-8 text"))?;
     parse_desc(&text, path)
