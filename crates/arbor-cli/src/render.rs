@@ -49,6 +49,10 @@ pub struct RenderArgs {
     /// Samples per pixel, overriding the scene's NumSamples.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub spp: Option<u32>,
+    /// Seed of every random choice (pixel samples, lens, time, area lights, glossy rays): the same seed
+    /// gives the same image on any number of threads, tiles or slices; another seed, independent noise.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     #[command(flatten)]
     pub threads: crate::threads::ThreadsArg,
     /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
@@ -207,6 +211,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         crop: args.crop,
         samples: None,
         cancel: Some(signals.cancel_flag()),
+        seed: args.seed,
     };
     let mut records = Vec::new();
     for (&c, target) in cameras.iter().zip(targets) {
@@ -219,7 +224,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                     Some(p) => std::fs::read(p).map_err(|e| arbor::Error::io(p, e))?,
                     None => EXAMPLE.as_bytes().to_vec(),
                 };
-                let id = identity(&scene_bytes, &cam.id, spp, cull, args.env.as_deref());
+                let id = identity(&scene_bytes, &cam.id, spp, args.seed, cull, args.env.as_deref());
                 let window = arbor::render::crop_window(opts.crop, cam.width, cam.height);
                 crate::memory::reserve_for(cam.width, cam.height, window, true)?;
                 let bar = Progress::new(args.quiet > 0, pixels(opts.crop, cam.width, cam.height), &cam.image_name);

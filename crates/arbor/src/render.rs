@@ -1,5 +1,8 @@
 //! Rendering one camera's image: 16x16 tiles traced in parallel over rayon. Each pixel sample draws from
 //! its own random stream ([`crate::sampler`]), so the image does not depend on thread count or tile order.
+//! A sample's random numbers are drawn in the course's order: the point in the pixel's stratum, the point
+//! on the lens, the time in the shutter interval (only when something moves), then whatever shading
+//! asks for.
 //!
 //! A crop ([`RenderOptions::crop`]) traces only the tiles of the full frame that overlap a window, with
 //! the full frame's pixel coordinates and random streams, so its pixels are those of the full render.
@@ -54,6 +57,9 @@ pub struct RenderOptions {
     pub samples: Option<(u32, u32)>,
     /// Stop early when this becomes true (a signal handler sets it): no tile starts after that.
     pub cancel: Option<Arc<AtomicBool>>,
+    /// Picks every random choice of the render ([`crate::sampler::Rng::for_sample`]); renders with
+    /// different seeds have independent noise.
+    pub seed: u64,
 }
 
 /// What a render measured.
@@ -204,6 +210,7 @@ fn trace(
     let done = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
+    let moving = scene.geometry.has_motion();
 
     let traced: Result<Traced> = tiles
         .par_iter()
@@ -223,9 +230,13 @@ fn trace(
                 rngs.clear();
                 for &(x, y) in group {
                     for k in k0..k1 {
-                        let mut rng = Rng::for_sample(x, y, k);
+                        let mut rng = Rng::for_sample(x, y, k, opts.seed);
                         let offset = pixel_offset(k, spp, &mut rng);
-                        let ray = cam.ray(x, y, offset, rng.next_2d());
+                        let mut ray = cam.ray(x, y, offset, rng.next_2d());
+                        // A time is drawn only when something moves, so still scenes keep their streams.
+                        if moving {
+                            ray = ray.with_time(rng.next_f32());
+                        }
                         batch.push(match &debug {
                             Some(_) => ray,
                             None => integrator.camera_ray(&ray),

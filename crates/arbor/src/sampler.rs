@@ -1,5 +1,6 @@
 //! Deterministic sampling: every pixel sample draws from its own small random stream, seeded by the
-//! pixel and sample index only, so an image is the same for any thread count and any tile order.
+//! render's seed, the pixel and the sample index only, so an image is the same for any thread count,
+//! tile order or split into sample ranges, and another seed gives independent noise.
 
 use crate::math::Vec2;
 
@@ -11,10 +12,11 @@ pub struct Rng {
 }
 
 impl Rng {
-    /// The stream for sample `sample` of pixel `(x, y)`.
-    pub fn for_sample(x: u32, y: u32, sample: u32) -> Rng {
+    /// The stream for sample `sample` of pixel `(x, y)` under `seed`.
+    pub fn for_sample(x: u32, y: u32, sample: u32, seed: u64) -> Rng {
         let pixel = ((y as u64) << 32) | x as u64;
-        let mut rng = Rng { state: 0, inc: (mix(pixel) << 1) | 1 };
+        // `mix(0)` is 0: seed 0 keeps the streams Arbor has always drawn (and the images they made).
+        let mut rng = Rng { state: 0, inc: ((mix(pixel) ^ mix(seed)) << 1) | 1 };
         rng.next_u32();
         rng.state = rng.state.wrapping_add(mix(sample as u64 ^ 0x9e37_79b9_7f4a_7c15));
         rng.next_u32();
@@ -66,17 +68,24 @@ pub fn pixel_offset(k: u32, n: u32, rng: &mut Rng) -> Vec2 {
 mod tests {
     use super::*;
 
+    /// The first value of pixel (3, 4)'s sample 0 before seeds existed.
+    const SEED0_FIRST: u32 = 3_548_415_727;
+
     #[test]
     fn sampler_streams_repeat_and_differ() {
-        let a: Vec<u32> = (0..4).map(|_| Rng::for_sample(3, 4, 0).next_u32()).collect();
+        let a: Vec<u32> = (0..4).map(|_| Rng::for_sample(3, 4, 0, 0).next_u32()).collect();
         assert!(a.windows(2).all(|w| w[0] == w[1]));
-        assert_ne!(Rng::for_sample(3, 4, 0).next_u32(), Rng::for_sample(4, 3, 0).next_u32());
-        assert_ne!(Rng::for_sample(3, 4, 0).next_u32(), Rng::for_sample(3, 4, 1).next_u32());
+        assert_ne!(Rng::for_sample(3, 4, 0, 0).next_u32(), Rng::for_sample(4, 3, 0, 0).next_u32());
+        assert_ne!(Rng::for_sample(3, 4, 0, 0).next_u32(), Rng::for_sample(3, 4, 1, 0).next_u32());
+        assert_ne!(Rng::for_sample(3, 4, 0, 0).next_u32(), Rng::for_sample(3, 4, 0, 1).next_u32());
+        assert_ne!(Rng::for_sample(3, 4, 0, 1).next_u32(), Rng::for_sample(3, 4, 0, 2).next_u32());
+        // Seed 0 is the stream of the original (seedless) sampler, pinned by its first value.
+        assert_eq!(Rng::for_sample(3, 4, 0, 0).next_u32(), SEED0_FIRST);
     }
 
     #[test]
     fn sampler_offsets_cover_their_strata() {
-        let mut rng = Rng::for_sample(0, 0, 0);
+        let mut rng = Rng::for_sample(0, 0, 0, 0);
         assert_eq!(pixel_offset(0, 1, &mut rng), Vec2::splat(0.5));
         for k in 0..16 {
             let o = pixel_offset(k, 16, &mut rng);
@@ -87,7 +96,7 @@ mod tests {
 
     #[test]
     fn sampler_floats_are_in_unit_interval_with_sane_mean() {
-        let mut rng = Rng::for_sample(7, 7, 7);
+        let mut rng = Rng::for_sample(7, 7, 7, 0);
         let xs: Vec<f32> = (0..10_000).map(|_| rng.next_f32()).collect();
         assert!(xs.iter().all(|&x| (0.0..1.0).contains(&x)));
         let mean = xs.iter().sum::<f32>() / xs.len() as f32;

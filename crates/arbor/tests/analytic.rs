@@ -20,6 +20,7 @@ fn material(ambient: f32, diffuse: f32, kind: MaterialKind) -> MaterialDesc {
         diffuse: Color::splat(diffuse),
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        roughness: 0.0,
         kind,
     }
 }
@@ -33,7 +34,14 @@ fn quad(z: f32, s: f32, facing_camera: bool) -> ShapeDesc {
 }
 
 fn object(shape: ShapeDesc, material: usize) -> ObjectDesc {
-    ObjectDesc { name: "o".into(), material, shape, transform: Transform::IDENTITY, loc: Location::file("test") }
+    ObjectDesc {
+        name: "o".into(),
+        material,
+        shape,
+        transform: Transform::IDENTITY,
+        motion: Vec3::ZERO,
+        loc: Location::file("test"),
+    }
 }
 
 /// A scene with a one-pixel camera at z = 10 looking down -z, ambient 100 and the given content.

@@ -29,7 +29,7 @@ impl Lcg {
 }
 
 fn object(shape: ShapeDesc, transform: Transform) -> ObjectDesc {
-    ObjectDesc { name: "o".into(), material: 0, shape, transform, loc: Location::file("test") }
+    ObjectDesc { name: "o".into(), material: 0, shape, transform, motion: Vec3::ZERO, loc: Location::file("test") }
 }
 
 fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {
@@ -41,6 +41,7 @@ fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });
     d.objects = objects;
@@ -187,6 +188,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             diffuse: Color::splat(1.0),
             specular: Color::splat(0.5),
             phong_exponent: 20.0,
+            roughness: 0.0,
             kind: MaterialKind::BlinnPhong,
         });
         d.objects.push(object(ShapeDesc::Sphere { center, radius: 50.0 }, Transform::IDENTITY));

@@ -24,7 +24,7 @@ fn quad() -> Arc<TriangleMesh> {
 }
 
 fn object(name: &str, shape: ShapeDesc, transform: Transform) -> ObjectDesc {
-    ObjectDesc { name: name.into(), material: 0, shape, transform, loc: Location::file("test") }
+    ObjectDesc { name: name.into(), material: 0, shape, transform, motion: Vec3::ZERO, loc: Location::file("test") }
 }
 
 fn desc(objects: Vec<ObjectDesc>) -> SceneDesc {
@@ -35,6 +35,7 @@ fn desc(objects: Vec<ObjectDesc>) -> SceneDesc {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });
     d.objects = objects;
@@ -211,4 +212,99 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
             }
         }
     }
+}
+
+/// `random_scene` with instances of instances (each instance shown again, moved on from where it is)
+/// and a translation over the shutter interval on every other object, plus a moving plane.
+fn moving_scene(rng: &mut Lcg) -> SceneDesc {
+    let mut d = random_scene(rng);
+    for i in 0..d.objects.len() {
+        if let ShapeDesc::Instance { base } = d.objects[i].shape {
+            let on_top = d.objects[i].transform.then(&Transform::translate(rng.v(6.0)));
+            d.objects.push(object("MeshInstance", ShapeDesc::Instance { base }, on_top));
+        }
+    }
+    for o in d.objects.iter_mut().step_by(2) {
+        o.motion = rng.v(8.0);
+    }
+    let mut plane =
+        object("Plane", ShapeDesc::Plane { point: Vec3::new(0.0, -9.0, 0.0), normal: Vec3::Y }, Transform::IDENTITY);
+    plane.motion = Vec3::new(0.0, 4.0, 0.0);
+    d.objects.push(plane);
+    d
+}
+
+/// The scene as it stands at `time`: every motion baked into its object's transform.
+fn frozen_at(d: &SceneDesc, time: f32) -> SceneDesc {
+    let mut f = d.clone();
+    for o in &mut f.objects {
+        o.transform = o.transform.then(&Transform::translate(o.motion * time));
+        o.motion = Vec3::ZERO;
+    }
+    f
+}
+
+#[test]
+fn two_level_moving_objects_match_brute_force_at_random_times() {
+    let mut rng = Lcg(31);
+    let mut hits = 0;
+    for _ in 0..3 {
+        let d = moving_scene(&mut rng);
+        let brute = build_geometry(&d, &AccelConfig::from(AccelKind::Brute)).unwrap();
+        assert!(brute.has_motion());
+        let rays: Vec<Ray> = (0..4_000)
+            .map(|_| {
+                let o = rng.v(30.0);
+                Ray::new(o, rng.v(12.0) - o).with_time(rng.f())
+            })
+            .collect();
+        let want: Vec<_> = rays.iter().map(|r| brute.intersect(r, f32::INFINITY)).collect();
+        hits += want.iter().filter(|h| h.is_some()).count();
+        for &kind in AccelKind::ALL {
+            let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
+            for (ray, want) in rays.iter().zip(&want) {
+                let got = g.intersect(ray, f32::INFINITY);
+                assert_eq!(want.map(|h| (h.prim, h.sub, h.t)), got.map(|h| (h.prim, h.sub, h.t)), "{kind} on {ray:?}");
+                let t_max = want.map_or(50.0, |h| h.t * 0.999);
+                assert_eq!(brute.occluded(ray, t_max), g.occluded(ray, t_max), "{kind} occluded on {ray:?}");
+            }
+            let mut out = vec![None; rays.len()];
+            g.intersect_many(&rays, f32::INFINITY, &mut out);
+            assert_eq!(out, want, "{kind}: batches at random times");
+        }
+    }
+    assert!(hits > 3_000, "too few hits: {hits}");
+}
+
+#[test]
+fn two_level_a_moving_object_is_where_its_motion_puts_it_at_the_rays_time() {
+    // Against the same scene frozen at the ray's time (motion baked into transforms, bounds computed
+    // afresh): the same primitive at the same distance up to rounding. Far from their time-0 place,
+    // moving objects are only found through the swept boxes.
+    let mut rng = Lcg(37);
+    let d = moving_scene(&mut rng);
+    let g = build_geometry(&d, &AccelConfig::default()).unwrap();
+    let (mut agree, mut total, mut moved_hits) = (0, 0, 0);
+    for time in [0.0, 0.25, 0.6, 0.999] {
+        let frozen = build_geometry(&frozen_at(&d, time), &AccelConfig::default()).unwrap();
+        assert!(!frozen.has_motion());
+        for _ in 0..5_000 {
+            let o = rng.v(30.0);
+            let ray = Ray::new(o, rng.v(12.0) - o);
+            match (g.intersect(&ray.with_time(time), f32::INFINITY), frozen.intersect(&ray, f32::INFINITY)) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    total += 1;
+                    assert!((a.t - b.t).abs() <= 1e-3 * a.t.max(1.0), "time {time}: t {} vs {}", a.t, b.t);
+                    if (a.prim, a.sub) == (b.prim, b.sub) {
+                        agree += 1;
+                        moved_hits += (time > 0.0 && a.prim % 2 == 0) as usize;
+                    }
+                }
+                _ => total += 1,
+            }
+        }
+    }
+    assert!(moved_hits > 1_000, "too few hits on moved objects: {moved_hits}");
+    assert!(agree as f64 >= 0.999 * total as f64, "{agree} of {total} hits on the same primitive");
 }

@@ -170,6 +170,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });
     let object = |shape| ObjectDesc {
@@ -177,6 +178,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
         material: 0,
         shape,
         transform: Transform::IDENTITY,
+        motion: Vec3::ZERO,
         loc: Location::file("test"),
     };
     desc.objects.push(object(ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false }));

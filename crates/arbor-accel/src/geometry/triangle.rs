@@ -215,7 +215,7 @@ mod tests {
         for (d, want) in cases {
             assert_eq!(major_axis(d), want, "{d:?}");
             // The traversal's box slack rests on this being the axis the watertight test divides by.
-            let ray = Ray { origin: Vec3::ZERO, dir: d, inv_dir: d.recip(), cull_backfaces: false };
+            let ray = Ray { origin: Vec3::ZERO, dir: d, inv_dir: d.recip(), time: 0.0, cull_backfaces: false };
             assert_eq!(RayFrame::new(&ray).kz, want, "{d:?}");
         }
     }

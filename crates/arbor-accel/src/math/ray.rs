@@ -2,7 +2,8 @@
 
 use super::Vec3;
 
-/// A half-line `origin + t * dir`, `t > 0`. `dir` need not be unit length (t is then in units of `dir`).
+/// A half-line `origin + t * dir`, `t > 0`, at one instant of the shutter interval. `dir` need not be unit
+/// length (t is then in units of `dir`).
 #[derive(Debug, Clone, Copy)]
 pub struct Ray {
     /// Start point.
@@ -11,6 +12,9 @@ pub struct Ray {
     pub dir: Vec3,
     /// `1 / dir` per component (infinite for zero components), for box tests.
     pub inv_dir: Vec3,
+    /// When in the shutter interval `[0, 1)` the ray sees the scene (motion blur). The structures never
+    /// read it; primitives that move take the ray to where they are at this time.
+    pub time: f32,
     /// Skip triangles seen from behind (primary rays only, when asked for).
     pub cull_backfaces: bool,
 }
@@ -27,12 +31,18 @@ impl Ray {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let tiny = dir.abs().cmplt(Vec3::splat(f32::MIN_POSITIVE));
         let dir = Vec3::select(tiny, dir * 0.0, dir);
-        Ray { origin, dir, inv_dir: dir.recip(), cull_backfaces: false }
+        Ray { origin, dir, inv_dir: dir.recip(), time: 0.0, cull_backfaces: false }
     }
     /// The same ray, culling back faces or not.
     #[inline]
     pub fn with_culling(mut self, cull: bool) -> Self {
         self.cull_backfaces = cull;
+        self
+    }
+    /// The same ray at shutter time `time`.
+    #[inline]
+    pub fn with_time(mut self, time: f32) -> Self {
+        self.time = time;
         self
     }
     /// The point at parameter `t`.

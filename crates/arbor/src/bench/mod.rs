@@ -101,6 +101,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
         diffuse: Color::splat(0.7),
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });
     desc.objects.push(ObjectDesc {
@@ -108,6 +109,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
         material: 0,
         shape: ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false },
         transform: Transform::IDENTITY,
+        motion: Vec3::ZERO,
         loc: Location::file(source),
     });
     desc
@@ -133,7 +135,7 @@ pub fn diffuse_rays(scene: &Scene, rays: &[Ray], hits: &[Option<Hit>]) -> Vec<Ra
             let hit = hit.as_ref()?;
             let s = scene.surface(ray, hit);
             let n = if ray.dir.dot(s.ng) < 0.0 { s.ng } else { -s.ng };
-            let mut rng = Rng::for_sample(i as u32, (i >> 32) as u32, 0x0d1f);
+            let mut rng = Rng::for_sample(i as u32, (i >> 32) as u32, 0x0d1f, 0);
             let u = rng.next_2d();
             let (t, bt) = orthonormal_basis(n);
             let (r, phi) = (u.x.sqrt(), std::f32::consts::TAU * u.y);

@@ -3,6 +3,9 @@
 //! dielectrics up to the recursion limit, with Beer's law along every segment travelled inside glass.
 //! Glass seen from inside gets no ambient or Blinn-Phong terms, only its lobes.
 //!
+//! Every ray of a camera sample keeps its time (motion blur). Rough materials send their lobes'
+//! rays off the ideal directions ([`crate::material::perturb`]), one random choice per lobe.
+//!
 //! Secondary ray origins are pushed off the surface to the side the new ray leaves from, so a ray never
 //! re-hits its own surface: by the scene's `ShadowRayEpsilon` or by the hit point's floating-point error
 //! bound ([`super::offset::spawn_origin`] decides).
@@ -12,7 +15,7 @@
 
 use super::offset::spawn_origin;
 use crate::accel::Hit;
-use crate::material::{beer, blinn_phong};
+use crate::material::{beer, blinn_phong, perturb};
 use crate::math::{Color, Ray};
 use crate::sampler::Rng;
 use crate::scene::Scene;
@@ -92,7 +95,8 @@ impl<'a> Whitted<'a> {
                 Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
             } else {
                 Ray::new(shadow_origin, ls.wi)
-            };
+            }
+            .with_time(ray.time);
             let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
@@ -108,7 +112,8 @@ impl<'a> Whitted<'a> {
                 if lobe.weight == Color::ZERO {
                     continue;
                 }
-                let origin = spawn_origin(scene.offset, &s, lobe.dir);
+                let dir = if m.roughness > 0.0 { perturb(lobe.dir, m.roughness, rng.next_2d()) } else { lobe.dir };
+                let origin = spawn_origin(scene.offset, &s, dir);
                 // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
                 // a reflected one stays in whatever medium it was in.
                 let next_inside = match (lobe.transmitted, front) {
@@ -116,7 +121,7 @@ impl<'a> Whitted<'a> {
                     (true, true) => m.interior_absorption(),
                     (true, false) => None,
                 };
-                let l = self.li(&Ray::new(origin, lobe.dir), depth + 1, next_inside, rng, count);
+                let l = self.li(&Ray::new(origin, dir).with_time(ray.time), depth + 1, next_inside, rng, count);
                 color += lobe.weight * l;
             }
         }

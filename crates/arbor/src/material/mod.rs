@@ -1,6 +1,6 @@
 //! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong`]), and the
 //! perfectly specular layer that mirrors, conductors and dielectrics add ([`SpecularLayer`]), each in
-//! the file named after its scene-file `type`. The scene's build step makes a [`Material`] from each
+//! the file named after its scene-file `type`, made glossy by a roughness ([`perturb`]). The scene's build step makes a [`Material`] from each
 //! material of the description; nothing here knows the scene file.
 //!
 //! A new kind of specular behaviour is a type in its own file implementing [`SpecularLayer`]; the
@@ -9,6 +9,7 @@
 mod blinn_phong;
 mod conductor;
 mod dielectric;
+mod glossy;
 mod mirror;
 mod transparent;
 
@@ -19,6 +20,7 @@ use crate::math::{Color, Vec3};
 pub use blinn_phong::blinn_phong;
 pub use conductor::{fresnel_conductor, Conductor};
 pub use dielectric::{beer, fresnel_dielectric, refract, Dielectric};
+pub use glossy::perturb;
 pub use mirror::Mirror;
 pub use transparent::Transparent;
 
@@ -64,6 +66,8 @@ pub struct Material {
     pub specular: Color,
     /// Blinn-Phong exponent.
     pub phong_exponent: f32,
+    /// How far the layer's rays stray from their ideal directions ([`perturb`]); 0 for none.
+    pub roughness: f32,
     /// Mirror, conductor, dielectric...; `None` for Blinn-Phong only (no secondary rays).
     pub layer: Option<Box<dyn SpecularLayer>>,
 }

@@ -15,7 +15,9 @@ use rayon::prelude::*;
 use super::desc::{
     CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule, SceneDesc, ShapeDesc,
 };
-use super::geometry::{prim_count, world_box, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, Shape};
+use super::geometry::{
+    prim_count, world_box, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape,
+};
 use super::runtime::{RayOffset, Scene};
 use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
@@ -23,6 +25,7 @@ use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
+use crate::math::Aabb;
 use crate::{Error, Location, Result};
 
 impl Scene {
@@ -113,6 +116,7 @@ fn build_material(desc: &MaterialDesc) -> Material {
         diffuse: desc.diffuse,
         specular: desc.specular,
         phong_exponent: desc.phong_exponent,
+        roughness: desc.roughness,
         layer,
     }
 }
@@ -170,7 +174,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             ShapeDesc::Plane { point, normal } => {
                 let point = object.transform.point(*point);
                 let normal = object.transform.normal(*normal).normalize();
-                planes.push((Plane { point, normal }, index as u32));
+                planes.push(ScenePlane { plane: Plane { point, normal }, object: index as u32, motion: object.motion });
                 continue;
             }
             ShapeDesc::Instance { .. } => unreachable!("resolve_instance never returns an instance"),
@@ -179,6 +183,8 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             Shape::Mesh(m) => world_box(&m.accel.bounds(), transform.as_ref()),
             Shape::Sphere(s) => s.bounds(),
         };
+        // A translation sweeps the box between its two ends; their union holds every box in between.
+        let bounds = bounds.union(Aabb::new(bounds.min + object.motion, bounds.max + object.motion));
         match &shape {
             Shape::Mesh(m) => counts.triangles += m.mesh.len(),
             Shape::Sphere(_) => counts.spheres += 1,
@@ -186,6 +192,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
         let object = SceneObject {
             transform: if matches!(shape, Shape::Sphere(_)) { None } else { transform },
             shape,
+            motion: object.motion,
             bounds,
             object: index as u32,
             first_prim,
@@ -326,6 +333,7 @@ mod tests {
             diffuse: Color::splat(0.2),
             specular: Color::splat(0.3),
             phong_exponent: 5.0,
+            roughness: 0.0,
             kind,
         };
         let plain = build_material(&desc(MaterialKind::BlinnPhong));

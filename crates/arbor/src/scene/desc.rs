@@ -229,6 +229,9 @@ pub struct MaterialDesc {
     pub specular: Color,
     /// Blinn-Phong exponent (1 when the file gives none).
     pub phong_exponent: f32,
+    /// How far reflected and refracted rays stray from the ideal direction (`Roughness`); 0 is a
+    /// perfect mirror or glass.
+    pub roughness: f32,
     /// Mirror, conductor, dielectric...
     pub kind: MaterialKind,
 }
@@ -285,6 +288,9 @@ pub struct ObjectDesc {
     pub shape: ShapeDesc,
     /// Object to world.
     pub transform: Transform,
+    /// World-space translation over the shutter interval (`MotionBlur`): the object is where `transform`
+    /// puts it at time 0 and moved by `motion` at time 1; zero for a still object.
+    pub motion: Vec3,
     /// Where the object is defined.
     pub loc: Location,
 }

@@ -6,6 +6,11 @@
 //! through its own transform, without copying either. Infinite planes have no bounds and are tested one
 //! by one after the hierarchy.
 //!
+//! Moving objects (motion blur) translate over the shutter interval: the top level bounds each by its
+//! swept box (the union of its boxes at times 0 and 1, exact for a translation), and a ray meets the
+//! object where it is at the ray's time by moving back by the object's displacement at that time, so
+//! the structures below stay static and every kind still agrees with brute force at any time.
+//!
 //! Ties between objects go to the lower object index, and inside an object to the lower triangle index,
 //! so every structure kind gives the same hits as brute force at both levels. [`super::build`] makes
 //! this geometry from a description.
@@ -46,7 +51,9 @@ pub struct SceneObject {
     pub shape: Shape,
     /// Object to world for meshes (spheres carry theirs); `None` for the identity.
     pub transform: Option<Transform>,
-    /// World-space bounds.
+    /// World-space translation over the shutter interval (zero for a still object).
+    pub motion: Vec3,
+    /// World-space bounds over the whole shutter interval.
     pub bounds: Aabb,
     /// Index into the description's objects.
     pub object: u32,
@@ -55,14 +62,51 @@ pub struct SceneObject {
 }
 
 impl SceneObject {
-    /// The ray in object space (same `t` as in world space).
+    /// The world ray relative to where the object is at the ray's time (same `t`).
+    #[inline]
+    fn still_ray(&self, ray: &Ray) -> Ray {
+        still_ray(ray, self.motion)
+    }
+
+    /// The ray in object space at the ray's time (same `t` as in world space).
     #[inline]
     fn local_ray(&self, ray: &Ray) -> Ray {
+        let ray = self.still_ray(ray);
         match &self.transform {
-            None => *ray,
+            None => ray,
             Some(t) => Ray::new(t.inv.transform_point3(ray.origin), t.inv.transform_vector3(ray.dir))
-                .with_culling(ray.cull_backfaces),
+                .with_culling(ray.cull_backfaces)
+                .with_time(ray.time),
         }
+    }
+}
+
+/// `ray` seen by an object moving by `motion` over the shutter interval, as if the object stood still
+/// where it is at time 0: the ray moves back by the object's displacement at the ray's time.
+#[inline]
+pub(super) fn still_ray(ray: &Ray, motion: Vec3) -> Ray {
+    if motion == Vec3::ZERO {
+        *ray
+    } else {
+        Ray { origin: ray.origin - ray.time * motion, ..*ray }
+    }
+}
+
+/// An infinite plane of the scene: tested one by one after the hierarchy (it has no bounds).
+#[derive(Debug, Clone, Copy)]
+pub struct ScenePlane {
+    /// The plane where it is at time 0.
+    pub plane: Plane,
+    /// Index into the description's objects.
+    pub object: u32,
+    /// World-space translation over the shutter interval.
+    pub motion: Vec3,
+}
+
+impl ScenePlane {
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.plane.intersect(&still_ray(ray, self.motion), t_max)
     }
 }
 
@@ -85,14 +129,14 @@ impl Primitives for SceneObjects {
         let o = &self.objects[i];
         match &o.shape {
             Shape::Mesh(m) => m.accel.intersect(&m.mesh, &o.local_ray(ray), t_max).map(nested),
-            Shape::Sphere(s) => s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0)),
+            Shape::Sphere(s) => s.intersect(&o.still_ray(ray), t_max).map(|t| PrimHit::new(t, 0.0, 0.0)),
         }
     }
     fn occludes(&self, i: usize, ray: &Ray, t_max: f32) -> bool {
         let o = &self.objects[i];
         match &o.shape {
             Shape::Mesh(m) => m.accel.occluded(&m.mesh, &o.local_ray(ray), t_max),
-            Shape::Sphere(s) => s.intersect(ray, t_max).is_some(),
+            Shape::Sphere(s) => s.intersect(&o.still_ray(ray), t_max).is_some(),
         }
     }
     fn intersect_counted(&self, i: usize, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<PrimHit> {
@@ -101,7 +145,7 @@ impl Primitives for SceneObjects {
             Shape::Mesh(m) => m.accel.intersect_counted(&m.mesh, &o.local_ray(ray), t_max, counts).map(nested),
             Shape::Sphere(s) => {
                 counts.prims += 1;
-                s.intersect(ray, t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
+                s.intersect(&o.still_ray(ray), t_max).map(|t| PrimHit::new(t, 0.0, 0.0))
             }
         }
     }
@@ -140,8 +184,8 @@ pub struct SceneGeometry {
     pub top: Box<dyn Accel<SceneObjects>>,
     /// Every distinct mesh with its structure.
     pub meshes: Vec<Arc<MeshShape>>,
-    /// Infinite planes and their description objects.
-    pub planes: Vec<(Plane, u32)>,
+    /// Infinite planes.
+    pub planes: Vec<ScenePlane>,
     /// Counts.
     pub counts: SceneCounts,
 }
@@ -229,7 +273,7 @@ impl SceneGeometry {
         mut counts: Option<&mut TraversalCounts>,
     ) -> Option<Hit> {
         let base = self.objects.len() as u32;
-        for (k, (plane, _)) in self.planes.iter().enumerate() {
+        for (k, plane) in self.planes.iter().enumerate() {
             if let Some(c) = counts.as_deref_mut() {
                 c.prims += 1;
             }
@@ -244,7 +288,7 @@ impl SceneGeometry {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         ray.is_valid()
-            && (self.planes.iter().any(|(p, _)| p.intersect(ray, t_max).is_some())
+            && (self.planes.iter().any(|p| p.intersect(ray, t_max).is_some())
                 || self.top.occluded(&self.objects, ray, t_max))
     }
 
@@ -304,6 +348,12 @@ impl SceneGeometry {
         }
         s.refs_per_prim = if s.primitives > 0 { refs / s.primitives as f64 } else { 0.0 };
         s
+    }
+
+    /// Whether anything moves over the shutter interval.
+    pub fn has_motion(&self) -> bool {
+        self.objects.objects.iter().any(|o| o.motion != Vec3::ZERO)
+            || self.planes.iter().any(|p| p.motion != Vec3::ZERO)
     }
 
     /// Bounds of the bounded objects.

@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use super::geometry::{SceneGeometry, Shape};
+use super::geometry::{SceneGeometry, ScenePlane, Shape};
 use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
@@ -93,6 +93,8 @@ impl Scene {
         let bound = self.offset == RayOffset::ErrorBound;
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
+                // Where a moving object is at the ray's time; shapes below are placed at time 0.
+                let shift = o.motion * ray.time;
                 let (ng, ns) = match &o.shape {
                     Shape::Mesh(m) => {
                         if bound {
@@ -101,6 +103,7 @@ impl Scene {
                                 None => (q, e),
                                 Some(t) => transform_point(t, q, e),
                             };
+                            p += shift;
                         }
                         let (ng, ns) = triangle_normals(&m.mesh, hit);
                         match &o.transform {
@@ -114,23 +117,28 @@ impl Scene {
                     }
                     Shape::Sphere(s) => {
                         if bound {
-                            let local = if s.transform.is_identity() { p } else { s.transform.inv.transform_point3(p) };
+                            let still = p - shift;
+                            let local =
+                                if s.transform.is_identity() { still } else { s.transform.inv.transform_point3(still) };
                             let (q, e) = sphere_point(local, s.center, s.radius);
                             (p, p_error) =
                                 if s.transform.is_identity() { (q, e) } else { transform_point(&s.transform, q, e) };
+                            p += shift;
                         }
-                        let n = s.normal_at(p);
+                        let n = s.normal_at(p - shift);
                         (n, n)
                     }
                 };
                 (ng, ns, o.object)
             }
             None => {
-                let (plane, object) = &g.planes[hit.prim as usize - g.objects.objects.len()];
+                let ScenePlane { plane, object, motion } = g.planes[hit.prim as usize - g.objects.objects.len()];
                 if bound {
-                    (p, p_error) = plane_point(p, plane.point, plane.normal);
+                    let shift = motion * ray.time;
+                    (p, p_error) = plane_point(p - shift, plane.point, plane.normal);
+                    p += shift;
                 }
-                (plane.normal, plane.normal, *object)
+                (plane.normal, plane.normal, object)
             }
         };
         Surface { p, p_error, ng, ns, object, material: self.object_materials[object as usize] }

@@ -451,12 +451,31 @@ mod tests {
         let body = format!(
             "{MATERIAL}<VertexData>0 0 0</VertexData><Objects>\
              <Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <MotionBlur>0 0 1</MotionBlur></Sphere>\
+             <Texture>1</Texture></Sphere>\
              <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <MotionBlur>0 0 1</MotionBlur></Sphere></Objects>"
+             <Texture>1</Texture></Sphere></Objects>"
         );
         let d = read_xml(&body).unwrap();
-        assert_eq!(d.warnings, ["t.xml:1:263: <MotionBlur>: motion blur is not supported; ignored (2 occurrences)"]);
+        assert_eq!(d.warnings, ["t.xml:1:263: <Texture>: textures are not supported; ignored (2 occurrences)"]);
+    }
+
+    #[test]
+    fn metu_motion_blur_and_roughness_are_read() {
+        let body = "<Materials><Material id=\"1\" type=\"mirror\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+             <DiffuseReflectance>0 0 0</DiffuseReflectance><MirrorReflectance>1 1 1</MirrorReflectance>\
+             <Roughness>0.25</Roughness></Material></Materials><VertexData>0 0 0</VertexData><Objects>\
+             <Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <MotionBlur>0 0 1.5</MotionBlur></Sphere>\
+             <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere></Objects>";
+        let d = read_xml(body).unwrap();
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+        assert_eq!(d.materials[0].roughness, 0.25);
+        assert_eq!(d.objects[0].motion, Vec3::new(0.0, 0.0, 1.5));
+        assert_eq!(d.objects[1].motion, Vec3::ZERO);
+        let negative = body.replace("0.25", "-0.5");
+        assert_eq!(read_xml(&negative).unwrap_err().to_string(), "t.xml:1:186: Material 1: negative roughness -0.5");
+        let short = body.replace("0 0 1.5", "0 1.5");
+        assert!(read_xml(&short).unwrap_err().to_string().starts_with("t.xml:1:"), "a motion of two numbers");
     }
 
     #[test]

@@ -128,6 +128,7 @@ fn material(m: &Obj<'_>, i: usize, warn: &mut Vec<String>) -> Result<MaterialDes
         diffuse: m.vec3("Diffuse")?,
         specular: m.vec3("Specular")?,
         phong_exponent: m.number("Shininess")?,
+        roughness: 0.0,
         kind,
     })
 }
@@ -185,7 +186,7 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
     let mut all = vec!["Type", "Material"];
     all.extend_from_slice(known);
     o.unknown(&all, warn);
-    Ok(ObjectDesc { name, material, shape, transform: Transform::IDENTITY, loc: o.loc(ty) })
+    Ok(ObjectDesc { name, material, shape, transform: Transform::IDENTITY, motion: Vec3::ZERO, loc: o.loc(ty) })
 }
 
 fn text_of(m: &Member) -> String {

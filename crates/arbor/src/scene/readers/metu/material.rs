@@ -74,12 +74,17 @@ impl Reader<'_> {
                 self.notes.feature(a.loc(p), &label, &msg);
             }
         }
-        // A zero roughness is a perfect mirror, which Arbor does render.
-        let rough = self.one(m, "Roughness");
-        if rough.is_some_and(|r| r.float(p).map_or(true, |v| v != 0.0)) {
-            self.unsupported(m, "Roughness", "glossy reflection is");
-        }
-        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, kind })
+        let roughness = match self.one(m, "Roughness") {
+            Some(n) => {
+                let r = n.float(p)?;
+                if r < 0.0 {
+                    return Err(self.err(n, format!("Material {id}: negative roughness {r}")));
+                }
+                r
+            }
+            None => 0.0,
+        };
+        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, roughness, kind })
     }
 
     /// The material an object names, as an index.

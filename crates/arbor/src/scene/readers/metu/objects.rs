@@ -53,7 +53,6 @@ impl Reader<'_> {
                 self.notes.feature(o.loc(self.path), &format!("<{kind}>"), what);
                 o.child("Radiance").map(Node::mark_subtree_used);
             }
-            self.unsupported(o, "MotionBlur", "motion blur is");
             self.unsupported(o, "Texture", "textures are");
             let (material, shape) = if kind == "MeshInstance" {
                 let base_id =
@@ -71,6 +70,10 @@ impl Reader<'_> {
                 (material, self.shape(o, &name)?)
             };
             let transform = self.transform_of(o)?;
+            let motion = match self.one(o, "MotionBlur") {
+                Some(n) => n.vec3(self.path)?,
+                None => Vec3::ZERO,
+            };
             let base = match kind {
                 "Mesh" => Some(Base::Mesh(self.desc.objects.len())),
                 "MeshInstance" => Some(Base::Instance(pending.len() - 1)),
@@ -83,7 +86,7 @@ impl Reader<'_> {
                     ids.insert(id.clone(), base);
                 }
             }
-            self.desc.objects.push(ObjectDesc { name, material, shape, transform, loc: o.loc(self.path) });
+            self.desc.objects.push(ObjectDesc { name, material, shape, transform, motion, loc: o.loc(self.path) });
         }
         self.resolve_instances(&pending, &ids)
     }
