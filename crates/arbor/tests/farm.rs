@@ -1,5 +1,5 @@
 //! Farm slices merge back into the single-process image bit for bit: tiles of a fixed grid (4 and 9),
-//! sample ranges (4 = 1+3 = 2+2 = 1+1+1+1), both at once, through partial EXR files on disk; and the
+//! sample ranges (4 = 1+3 = 2+2 = 1+1+1+1; 16 = 5+1+10 with every distribution effect), both at once, through partial EXR files on disk; and the
 //! merge refuses parts that do not fit together, with messages naming the file.
 
 use std::path::{Path, PathBuf};
@@ -58,6 +58,30 @@ fn farm_tiles_and_sample_ranges_merge_to_the_whole() {
             assert_eq!(bits(&merged), bits(&whole), "{n} tiles, samples {ranges:?}");
             assert_eq!(merged.to_rgb8(), whole.to_rgb8());
         }
+    }
+}
+
+#[test]
+fn farm_distribution_effects_merge_to_the_whole() {
+    // Depth of field, motion blur, glossy rays and an area light at 16 samples per pixel, split into
+    // tiles and uneven sample ranges.
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/distribution.xml"));
+    let mut desc = arbor::scene::load_desc(path).unwrap_or_else(|e| panic!("{e}"));
+    for c in &mut desc.cameras {
+        (c.width, c.height) = (c.width / 8, c.height / 8 + 1);
+    }
+    assert_eq!(desc.cameras[0].num_samples, 16);
+    let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap();
+    assert!(scene.geometry.has_motion());
+    let dir = tempfile::tempdir().unwrap();
+    let whole = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0;
+    for n in [1, 4] {
+        let parts: Vec<_> = (0..n)
+            .flat_map(|i| [(0, 5), (5, 6), (6, 16)].into_iter().map(move |r| (i, r)))
+            .map(|(i, r)| part(&scene, dir.path(), Some((i, n)), r))
+            .collect();
+        let merged = merge(&parts).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(bits(&merged), bits(&whole), "{n} tiles");
     }
 }
 

@@ -5,7 +5,8 @@
 //! JSON set, the NYU bunny) is rendered at a third of its resolution (the image-plane window does not
 //! depend on the resolution) on a pool of 1 and of 2 rayon threads, and the films compared bit for bit.
 //! Several samples per pixel with an area light (random numbers in every pixel) are covered by the
-//! 2019 `cornellbox_area.xml` and the project's own Cornell box. Tile order: a film assembled from
+//! 2019 `cornellbox_area.xml` and the project's own Cornell box; every random choice of distribution ray
+//! tracing (lens, time, glossy rays) and the seed by the project's `distribution.xml`. Tile order: a film assembled from
 //! one-tile crops rendered in reverse order equals the full render.
 
 mod common;
@@ -100,6 +101,33 @@ fn example() -> Scene {
     let desc = shrink(desc.unwrap_or_else(|e| panic!("{e}")), 4);
     assert!(desc.cameras[0].num_samples > 1);
     Scene::build(desc, &AccelConfig::default(), None).unwrap()
+}
+
+/// The distribution ray tracing example (area light, glossy metal and glass, depth of field, moving
+/// objects: every random choice of a sample), at a quarter of its size.
+fn distribution() -> Scene {
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/distribution.xml"));
+    let desc = shrink(load_desc(path).unwrap_or_else(|e| panic!("{e}")), 4);
+    assert!(desc.cameras[0].num_samples > 1);
+    Scene::build(desc, &AccelConfig::default(), None).unwrap()
+}
+
+#[test]
+fn reproducible_distribution_effects_for_threads_crops_and_seeds() {
+    let scene = distribution();
+    assert!(scene.geometry.has_motion());
+    let seeded = |seed| RenderOptions { seed, ..Default::default() };
+    let full = render_on(2, &scene, 0, &seeded(7));
+    assert_eq!(bits(&full), bits(&render_on(1, &scene, 0, &seeded(7))), "1 and 2 threads");
+    let crop = (5, 9, 61, 40);
+    let part = render_on(1, &scene, 0, &RenderOptions { crop: Some(crop), ..seeded(7) });
+    assert_eq!(bits(&part), window(&full, crop), "crop");
+    // Another seed draws other samples: most pixels change (noise), none by much on average.
+    let other = render_on(2, &scene, 0, &seeded(8));
+    let changed = full.pixels.iter().zip(&other.pixels).filter(|(a, b)| a != b).count();
+    assert!(changed * 2 > full.pixels.len(), "only {changed} of {} pixels differ between seeds", full.pixels.len());
+    let mean = |f: &Film| f.pixels.iter().map(|c| c.element_sum() as f64).sum::<f64>() / f.pixels.len() as f64;
+    assert!((mean(&full) - mean(&other)).abs() < 0.01 * mean(&full), "{} vs {}", mean(&full), mean(&other));
 }
 
 /// The pixels `x0..x1` x `y0..y1` of `film`.
