@@ -1,5 +1,6 @@
-//! How far an image is from its reference, in 8-bit levels: PSNR, RMSE, the largest channel difference and
-//! the share of pixels that differ by more than a threshold.
+//! How far an image is from its reference, in 8-bit levels: PSNR, RMSE, the largest channel difference,
+//! the share of pixels that differ by more than a threshold, and the bias (the mean signed difference per
+//! channel, image minus reference).
 //!
 //! All statistics are over the three channels of every pixel (alpha is never compared: [`compare_files`]
 //! reads both images with [`read_rgb8`](super::read_rgb8)). PSNR uses a peak of 255:
@@ -29,6 +30,8 @@ pub struct Comparison {
     pub pixels_off: usize,
     /// `pixels_off` divided by the pixel count (0 for an empty image).
     pub share_off: f64,
+    /// Mean signed difference per channel (R, G, B), image minus reference, in levels (0 for an empty image).
+    pub bias: [f64; 3],
 }
 
 impl Comparison {
@@ -53,6 +56,21 @@ impl Comparison {
             self.max_diff
         )
     }
+
+    /// One line for a human: the mean signed difference per channel.
+    pub fn bias_summary(&self) -> String {
+        bias_text(self.bias)
+    }
+}
+
+/// `bias (image minus reference): R +0.125, G -0.500, B +0.000 levels`.
+fn bias_text(bias: [f64; 3]) -> String {
+    format!("bias (image minus reference): R {:+.3}, G {:+.3}, B {:+.3} levels", bias[0], bias[1], bias[2])
+}
+
+/// The mean of each channel's signed sum over `pixels` pixels (0 when there are none).
+fn means(sums: [i64; 3], pixels: usize) -> [f64; 3] {
+    sums.map(|s| if pixels == 0 { 0.0 } else { s as f64 / pixels as f64 })
 }
 
 /// Compares two row-major 8-bit RGB images of `width` x `height` pixels.
@@ -67,12 +85,14 @@ pub fn compare_rgb8(reference: &[u8], image: &[u8], width: u32, height: u32, thr
     let mut sum_sq = 0u64;
     let mut max_diff = 0u8;
     let mut pixels_off = 0usize;
+    let mut signed = [0i64; 3];
     for (r, i) in reference.chunks_exact(3).zip(image.chunks_exact(3)) {
         let mut pixel_max = 0u8;
-        for (&a, &b) in r.iter().zip(i) {
+        for ((&a, &b), sum) in r.iter().zip(i).zip(&mut signed) {
             let d = a.abs_diff(b);
             sum_sq += u64::from(d) * u64::from(d);
             pixel_max = pixel_max.max(d);
+            *sum += i64::from(b) - i64::from(a);
         }
         max_diff = max_diff.max(pixel_max);
         pixels_off += usize::from(pixel_max > threshold);
@@ -87,6 +107,7 @@ pub fn compare_rgb8(reference: &[u8], image: &[u8], width: u32, height: u32, thr
         max_diff,
         pixels_off,
         share_off: if pixels == 0 { 0.0 } else { pixels_off as f64 / pixels as f64 },
+        bias: means(signed, pixels),
     }
 }
 
@@ -157,17 +178,37 @@ mod tests {
     }
 
     #[test]
-    fn compare_difference_is_symmetric_in_sign() {
+    fn compare_difference_is_symmetric_in_sign_except_bias() {
         let a = grey(10, 1);
         let b = grey(250, 1);
-        assert_eq!(compare_rgb8(&a, &b, 1, 1, 0), compare_rgb8(&b, &a, 1, 1, 0));
-        assert_eq!(compare_rgb8(&a, &b, 1, 1, 0).max_diff, 240);
+        let (ab, ba) = (compare_rgb8(&a, &b, 1, 1, 0), compare_rgb8(&b, &a, 1, 1, 0));
+        assert_eq!((ab.bias, ba.bias), ([240.0; 3], [-240.0; 3]));
+        assert_eq!(ab, Comparison { bias: [240.0; 3], ..ba });
+        assert_eq!(ab.max_diff, 240);
+    }
+
+    #[test]
+    fn compare_bias_is_mean_signed_difference_per_channel() {
+        // Two pixels: R +5 and -1 (mean +2), G +0 and +1 (mean +0.5), B -4 and -4.
+        let reference = [100, 100, 100, 50, 50, 50];
+        let image = [105, 100, 96, 49, 51, 46];
+        let c = compare_rgb8(&reference, &image, 2, 1, 8);
+        assert_eq!(c.bias, [2.0, 0.5, -4.0]);
+        assert_eq!(c.bias_summary(), "bias (image minus reference): R +2.000, G +0.500, B -4.000 levels");
+        assert_eq!(c.pixels_off, 0);
+    }
+
+    #[test]
+    fn compare_uniform_offset_is_its_bias() {
+        let reference = grey(100, 6);
+        let image: Vec<u8> = [103, 100, 98].repeat(6);
+        assert_eq!(compare_rgb8(&reference, &image, 3, 2, 0).bias, [3.0, 0.0, -2.0]);
     }
 
     #[test]
     fn compare_empty_images_are_equal() {
         let c = compare_rgb8(&[], &[], 0, 0, 0);
-        assert_eq!((c.pixels_off, c.share_off), (0, 0.0));
+        assert_eq!((c.pixels_off, c.share_off, c.bias), (0, 0.0, [0.0; 3]));
     }
 
     #[test]
