@@ -1,8 +1,10 @@
-//! `arbor diff`: compares an image with a reference the way the reference-image tests do.
+//! `arbor diff`: compares an image with a reference the way the reference-image tests do: pixel by pixel,
+//! or, for a render of random samples whose noise cannot match pixel for pixel, by the means of KxK-pixel
+//! blocks (`--block K`). Both print the bias, the mean signed difference per channel.
 
 use std::path::PathBuf;
 
-use arbor::image_io::metrics::compare_files;
+use arbor::image_io::metrics::{compare_blocks_files, compare_files};
 use clap::Args;
 
 use crate::Failure;
@@ -14,32 +16,67 @@ pub struct DiffArgs {
     pub reference: PathBuf,
     /// The image to check.
     pub image: PathBuf,
-    /// A pixel is "off" when a channel differs by more than this many 8-bit levels.
+    /// A pixel (or block) is "off" when a channel differs by more than this many 8-bit levels.
     #[arg(long, default_value_t = 8)]
     pub threshold: u8,
-    /// Fail (exit 1) when more than this percentage of pixels is off.
+    /// Fail (exit 1) when more than this percentage of pixels (or blocks) is off.
     #[arg(long, default_value_t = 0.5)]
     pub max_off: f64,
+    /// Compare the means of KxK-pixel blocks instead of pixels, for noisy renders (blocks at the right and
+    /// bottom edges are averaged over the pixels they have).
+    #[arg(long, value_name = "K", value_parser = parse_block)]
+    pub block: Option<u32>,
+}
+
+/// Parses `--block`: a whole number of pixels, at least 1.
+fn parse_block(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(0) => Err("a block is at least 1 pixel wide".into()),
+        Ok(k) => Ok(k),
+        Err(_) => Err(format!("'{s}' is not a whole number of pixels")),
+    }
 }
 
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
-    let c = compare_files(&args.reference, &args.image, args.threshold)?;
-    say!("{}", c.summary());
-    if c.share_off * 100.0 > args.max_off {
-        say!(
-            "FAIL: {:.3}% of pixels off by more than {} levels (limit {}%)",
-            c.share_off * 100.0,
-            args.threshold,
-            args.max_off
-        );
-        return Err(Failure::TooDifferent);
-    }
+    let (share_off, what) = match args.block {
+        None => {
+            let c = compare_files(&args.reference, &args.image, args.threshold)?;
+            say!("{}", c.summary());
+            say!("{}", c.bias_summary());
+            (c.share_off, "pixels".to_string())
+        }
+        Some(k) => {
+            let c = compare_blocks_files(&args.reference, &args.image, k, args.threshold)?;
+            say!("{}", c.summary());
+            say!("{}", c.bias_summary());
+            (c.share_off, format!("blocks of {k}x{k} pixels"))
+        }
+    };
+    let failed = share_off * 100.0 > args.max_off;
     say!(
-        "OK: {:.3}% of pixels off by more than {} levels (limit {}%)",
-        c.share_off * 100.0,
+        "{}: {:.3}% of {what} off by more than {} levels (limit {}%)",
+        if failed { "FAIL" } else { "OK" },
+        share_off * 100.0,
         args.threshold,
         args.max_off
     );
+    if failed {
+        return Err(Failure::TooDifferent);
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_block_takes_one_and_more_only() {
+        assert_eq!(parse_block("1"), Ok(1));
+        assert_eq!(parse_block(" 16 "), Ok(16));
+        assert_eq!(parse_block("0"), Err("a block is at least 1 pixel wide".into()));
+        assert_eq!(parse_block("-2"), Err("'-2' is not a whole number of pixels".into()));
+        assert_eq!(parse_block("4x4"), Err("'4x4' is not a whole number of pixels".into()));
+    }
 }

@@ -49,7 +49,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Merge partial EXRs of render slices (tiles, sample ranges) into the full image.
     Merge(merge::MergeArgs),
-    /// Compare an image with a reference: PSNR and the share of pixels off by more than a threshold.
+    /// Compare an image with a reference: PSNR, bias and the share of pixels (or, for noisy renders, of
+    /// KxK-pixel block means) off by more than a threshold.
     Diff(diff::DiffArgs),
 }
 

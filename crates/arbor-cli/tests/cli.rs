@@ -163,9 +163,82 @@ fn cli_diff_passes_identical_and_fails_different_images() {
     assert!(arbor(&["render", "-q", "-o", "b", b.to_str().unwrap()], tmp.path()).status.success());
     let same = arbor(&["diff", "a/tiny.png", "a/tiny.png"], tmp.path());
     assert_eq!(same.status.code(), Some(0), "{}", stdout(&same));
+    let want = "PSNR inf (identical), RMSE 0.000 levels, 0 of 384 pixels off (0.000%), max diff 0
+bias (image minus reference): R +0.000, G +0.000, B +0.000 levels
+OK: 0.000% of pixels off by more than 8 levels (limit 0.5%)
+";
+    assert_eq!(stdout(&same), want);
     let differ = arbor(&["diff", "a/tiny.png", "b/tiny.png"], tmp.path());
     assert_eq!(differ.status.code(), Some(1), "{}", stdout(&differ));
     assert!(stdout(&differ).contains("PSNR"), "{}", stdout(&differ));
+}
+
+/// Writes a binary PPM of `width` x `height` pixels whose pixel (x, y) is `f(x, y)`.
+fn ppm(dir: &Path, name: &str, width: u32, height: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
+    let mut bytes = format!("P6\n{width} {height}\n255\n").into_bytes();
+    bytes.extend((0..height).flat_map(|y| (0..width).map(move |x| (x, y))).flat_map(|(x, y)| f(x, y)));
+    std::fs::write(dir.join(name), bytes).unwrap();
+}
+
+#[test]
+fn cli_diff_blocks_pass_noise_that_pixels_fail() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Grey 100 against a checkerboard of +-20 that cancels in every 2x2 block, with a bias of R +1, B -2.
+    let noise = |x: u32, y: u32| if (x + y).is_multiple_of(2) { [121, 120, 118] } else { [81, 80, 78] };
+    ppm(tmp.path(), "ref.ppm", 4, 2, |_, _| [100; 3]);
+    ppm(tmp.path(), "noisy.ppm", 4, 2, noise);
+    let bias = "bias (image minus reference): R +1.000, G +0.000, B -2.000 levels\n";
+    let o = arbor(&["diff", "ref.ppm", "noisy.ppm"], tmp.path());
+    let want = format!(
+        "PSNR 22.09 dB, RMSE 20.042 levels, 8 of 8 pixels off (100.000%), max diff 22\n{bias}\
+         FAIL: 100.000% of pixels off by more than 8 levels (limit 0.5%)\n"
+    );
+    assert_eq!((o.status.code(), stdout(&o), stderr(&o)), (Some(1), want, String::new()));
+    let o = arbor(&["diff", "ref.ppm", "noisy.ppm", "--block", "2"], tmp.path());
+    let want = format!(
+        "0 of 2 blocks of 2x2 pixels off (0.000%), max block diff 2.000 levels\n{bias}\
+         OK: 0.000% of blocks of 2x2 pixels off by more than 8 levels (limit 0.5%)\n"
+    );
+    assert_eq!((o.status.code(), stdout(&o), stderr(&o)), (Some(0), want, String::new()));
+    // The bias itself is off when nothing is tolerated.
+    let o = arbor(&["diff", "ref.ppm", "noisy.ppm", "--block", "2", "--threshold", "0"], tmp.path());
+    let want = format!(
+        "2 of 2 blocks of 2x2 pixels off (100.000%), max block diff 2.000 levels\n{bias}\
+         FAIL: 100.000% of blocks of 2x2 pixels off by more than 0 levels (limit 0.5%)\n"
+    );
+    assert_eq!((o.status.code(), stdout(&o)), (Some(1), want));
+}
+
+#[test]
+fn cli_diff_blocks_fail_an_error_the_noise_does_not_hide() {
+    let tmp = tempfile::tempdir().unwrap();
+    // 5x4 pixels in 2x2 blocks, the right column of blocks 1 pixel wide: noise of +-20 that cancels in
+    // every block, and G 12 levels too bright in the 2x2 block at x 2..4, y 2..4.
+    let wrong = |x: u32, y: u32| {
+        let v = if (x + y).is_multiple_of(2) { 120 } else { 80 };
+        [v, if x / 2 == 1 && y / 2 == 1 { v + 12 } else { v }, v]
+    };
+    ppm(tmp.path(), "ref.ppm", 5, 4, |_, _| [100; 3]);
+    ppm(tmp.path(), "wrong.ppm", 5, 4, wrong);
+    let found = "1 of 6 blocks of 2x2 pixels off (16.667%), max block diff 12.000 levels
+bias (image minus reference): R +0.000, G +2.400, B +0.000 levels
+";
+    let o = arbor(&["diff", "ref.ppm", "wrong.ppm", "--block", "2"], tmp.path());
+    let want = format!("{found}FAIL: 16.667% of blocks of 2x2 pixels off by more than 8 levels (limit 0.5%)\n");
+    assert_eq!((o.status.code(), stdout(&o)), (Some(1), want));
+    let o = arbor(&["diff", "ref.ppm", "wrong.ppm", "--block", "2", "--max-off", "20"], tmp.path());
+    let want = format!("{found}OK: 16.667% of blocks of 2x2 pixels off by more than 8 levels (limit 20%)\n");
+    assert_eq!((o.status.code(), stdout(&o)), (Some(0), want));
+}
+
+#[test]
+fn cli_diff_block_zero_is_a_usage_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    ppm(tmp.path(), "ref.ppm", 2, 2, |_, _| [100; 3]);
+    let o = arbor(&["diff", "ref.ppm", "ref.ppm", "--block", "0"], tmp.path());
+    let want = "error: invalid value '0' for '--block <K>': a block is at least 1 pixel wide\n\n\
+                For more information, try '--help'.\n";
+    assert_eq!((o.status.code(), stdout(&o), stderr(&o)), (Some(2), String::new(), want.to_string()));
 }
 
 #[test]

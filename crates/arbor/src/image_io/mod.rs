@@ -6,7 +6,8 @@
 //!   target, so a failed run never leaves a half-written image and never destroys the previous one.
 //! - [`read_image`]: PNG, JPEG, PNM, OpenEXR, Radiance HDR into a film in display units (integer samples
 //!   divided by their maximum, float samples as they are); [`read_rgb8`] for exact 8-bit comparisons.
-//! - [`metrics`]: PSNR, RMSE and the share of differing pixels against a reference image.
+//! - [`metrics`]: PSNR, RMSE, bias and the share of differing pixels (or KxK-pixel block means, for noisy
+//!   renders) against a reference image.
 //!
 //! Codecs are the `image` crate's; this module only chooses formats, converts samples and handles files.
 
@@ -14,6 +15,8 @@ pub mod metrics;
 mod read;
 pub(crate) mod write;
 
-pub use metrics::{compare_files, compare_rgb8, diff_image, Comparison};
+pub use metrics::{
+    compare_blocks_files, compare_blocks_rgb8, compare_files, compare_rgb8, diff_image, BlockComparison, Comparison,
+};
 pub use read::{read_image, read_rgb8};
 pub use write::{write_image, SUPPORTED_WRITE_EXTENSIONS};
