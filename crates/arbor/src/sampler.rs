@@ -53,15 +53,30 @@ fn mix(mut z: u64) -> u64 {
 }
 
 /// The image-plane offset in `[0, 1)²` of sample `k` of `n`: the pixel centre for one sample, otherwise
-/// a jittered point in cell `k` of a `cols x rows` grid (`cols = ceil(sqrt(n))`).
+/// a jittered point in cell `k` of a `cols x rows` grid (`cols = ceil(sqrt(n))`, `rows = ceil(n / cols)`).
+/// When `n` does not fill that grid (`--spp 10`: 4 x 3 cells for 10 samples), the `rows` rows hold
+/// `n / rows` or one more samples each and are as tall as their share of the samples, so that every cell
+/// still covers `1/n` of the pixel and the estimate stays unbiased.
 pub fn pixel_offset(k: u32, n: u32, rng: &mut Rng) -> Vec2 {
     if n <= 1 {
         return Vec2::splat(0.5);
     }
     let cols = (n as f32).sqrt().ceil() as u32;
     let rows = n.div_ceil(cols);
-    let cell = Vec2::new((k % cols) as f32, (k / cols) as f32);
-    (cell + rng.next_2d()) / Vec2::new(cols as f32, rows as f32)
+    if cols * rows == n {
+        let cell = Vec2::new((k % cols) as f32, (k / cols) as f32);
+        return (cell + rng.next_2d()) / Vec2::new(cols as f32, rows as f32);
+    }
+    // The first `n % rows` rows hold one sample more than the others.
+    let (short, long) = (n / rows, n / rows + 1);
+    let long_rows = n % rows;
+    let (row, col, len) = match k.checked_sub(long_rows * long) {
+        None => (k / long, k % long, long),
+        Some(j) => (long_rows + j / short, j % short, short),
+    };
+    let first = row * short + row.min(long_rows);
+    let r = rng.next_2d();
+    Vec2::new((col as f32 + r.x) / len as f32, (first as f32 + r.y * len as f32) / n as f32)
 }
 
 #[cfg(test)]
@@ -91,6 +106,43 @@ mod tests {
             let o = pixel_offset(k, 16, &mut rng);
             let cell = (o * 4.0).floor();
             assert_eq!(cell, Vec2::new((k % 4) as f32, (k / 4) as f32));
+        }
+    }
+
+    #[test]
+    fn sampler_offsets_of_a_partial_grid_cover_equal_strata() {
+        // 10 samples: rows of 4, 3 and 3, heights 4/10, 3/10, 3/10; every cell 1/10 of the pixel.
+        let mut rng = Rng::for_sample(1, 2, 3, 0);
+        let rows = [(0.0, 0.4, 4), (0.4, 0.7, 3), (0.7, 1.0, 3)];
+        let mut k = 0;
+        for &(y0, y1, len) in &rows {
+            for c in 0..len {
+                for _ in 0..50 {
+                    let o = pixel_offset(k, 10, &mut rng);
+                    let (x0, x1) = (c as f32 / len as f32, (c + 1) as f32 / len as f32);
+                    assert!(o.x >= x0 && o.x <= x1 && o.y >= y0 - 1e-6 && o.y <= y1 + 1e-6, "{k}: {o}");
+                }
+                k += 1;
+            }
+        }
+        assert_eq!(k, 10);
+        // Any count: offsets stay in the pixel, and the samples' mean is its centre.
+        for n in 2..=50 {
+            let mut sum = Vec2::ZERO;
+            for _ in 0..200 {
+                for k in 0..n {
+                    let o = pixel_offset(k, n, &mut rng);
+                    assert!(o.min_element() >= 0.0 && o.max_element() <= 1.0, "{k} of {n}: {o}");
+                    sum += o;
+                }
+            }
+            let mean = sum / (200 * n) as f32;
+            assert!((mean - Vec2::splat(0.5)).abs().max_element() < 0.02, "{n}: mean {mean}");
+        }
+        // Full grids that are not square keep their rectangular cells: 6 = 3 x 2.
+        for k in 0..6 {
+            let o = pixel_offset(k, 6, &mut rng);
+            assert_eq!((o * Vec2::new(3.0, 2.0)).floor(), Vec2::new((k % 3) as f32, (k / 3) as f32));
         }
     }
 
