@@ -81,6 +81,10 @@ fn catalogue() -> Vec<Row> {
     render("mesh_nan_binary_ply.xml", 3, "error: nan_binary.ply: byte 193: vertex 2: non-finite y (NaN)\n"),
     render("mesh_inf_obj.xml", 3, "error: inf.obj:3:5: non-finite coordinate `inf`\n"),
     render("mesh_inf_off.xml", 3, "error: inf.off:5:5: non-finite coordinate `-inf`\n"),
+    // Camera values outside their domain.
+    render("num_samples_zero.xml", 3, "error: num_samples_zero.xml:10:13: Camera 1: NumSamples 0 must be at least 1\n"),
+    render("num_samples_negative.xml", 3, "error: num_samples_negative.xml:10:13: Camera 1: NumSamples -9 must be at least 1\n"),
+    render("num_samples_not_square.xml", 0, "warning: num_samples_not_square.xml:10:13: Camera 1: NumSamples 10 is not a perfect square; using 9 (3x3)\n"),
     // Indices out of range.
     render("face_index_out_of_range.xml", 3, "error: face_index_out_of_range.xml:29:44: Mesh 1: vertex index 9 out of range (VertexData has 3 vertices, numbered from 1)\n"),
     render("face_index_zero.xml", 3, "error: face_index_zero.xml:29:44: Mesh 1: vertex index 0 out of range (VertexData has 3 vertices, numbered from 1)\n"),
@@ -135,7 +139,7 @@ fn catalogue() -> Vec<Row> {
     render("huge_image.xml", 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     render("huge_samples.xml", 3, "error: huge_samples.xml:3:9: Camera 1: NumSamples 1000000 exceeds the limit of 65536 samples per pixel; --no-limits lifts the limits\n"),
     render("huge_work.xml", 3, "error: huge_work.xml:3:9: Camera 1: 268435456 pixels x 1024 samples = 274877906944 samples, more than the limit of 17179869184; --no-limits lifts the limits\n"),
-    render("huge_work_cameras.xml", 3, "error: huge_work_cameras.xml: the scene's 2 cameras ask for 21474836480 samples in all, more than the limit of 17179869184; --no-limits lifts the limits\n"),
+    render("huge_work_cameras.xml", 3, "error: huge_work_cameras.xml: the scene's 2 cameras ask for 19327352832 samples in all, more than the limit of 17179869184; --no-limits lifts the limits\n"),
     render("deep_recursion.xml", 3, "error: deep_recursion.xml:2:5: MaxRecursionDepth 100 exceeds the limit of 64; --no-limits lifts the limits\n"),
     // Not a scene file.
     render("not_utf8.xml", 3, "error: not_utf8.xml: byte 309: not UTF-8 text\n"),

@@ -138,7 +138,7 @@ pub struct CameraDesc {
     pub height: u32,
     /// Output file name, relative to the output folder; its extension picks the format.
     pub image_name: String,
-    /// Samples per pixel (`NumSamples`), at least 1.
+    /// Samples per pixel (`NumSamples`), at least 1; the METU readers give a perfect square.
     pub num_samples: u32,
     /// Camera transform (applied to position, gaze and up).
     pub transform: Transform,

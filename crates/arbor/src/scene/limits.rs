@@ -126,15 +126,15 @@ mod tests {
         assert_eq!(e, format!("s.xml:4:1: Camera c: image 20000x10 exceeds the limit of 16384x16384 pixels{lift}"));
         let e = err(&scene("16384 16385", 1, 0), None);
         assert!(e.contains("exceeds the limit of 16384x16384"), "{e}");
-        let e = err(&scene("8 8", 65537, 0), None);
+        let e = err(&scene("8 8", 66049, 0), None);
         assert_eq!(
             e,
-            format!("s.xml:4:1: Camera c: NumSamples 65537 exceeds the limit of 65536 samples per pixel{lift}")
+            format!("s.xml:4:1: Camera c: NumSamples 66049 exceeds the limit of 65536 samples per pixel{lift}")
         );
         let e = err(&scene("8 8", 1, 65), None);
         assert_eq!(e, format!("s.xml:2:1: MaxRecursionDepth 65 exceeds the limit of 64{lift}"));
-        let e = err(&scene("16384 16384", 65, 0), None);
-        assert!(e.contains("268435456 pixels x 65 samples = 17448304640 samples, more than the limit of 17179869184"));
+        let e = err(&scene("16384 16384", 81, 0), None);
+        assert!(e.contains("268435456 pixels x 81 samples = 21743271936 samples, more than the limit of 17179869184"));
         let e = err(&scene("8 8", 1, 0), Some(65537));
         assert_eq!(e, format!("--spp 65537 exceeds the limit of 65536 samples per pixel{lift}"));
         // The command line's samples replace the scene's, for the total too.
@@ -148,7 +148,7 @@ mod tests {
             format!(
                 "<Camera id=\"{id}\"><Position>0 0 5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>\
                  <NearPlane>-1 1 -1 1</NearPlane><NearDistance>1</NearDistance>\
-                 <ImageResolution>16384 16384</ImageResolution><NumSamples>40</NumSamples>\
+                 <ImageResolution>16384 16384</ImageResolution><NumSamples>36</NumSamples>\
                  <ImageName>{id}.png</ImageName></Camera>"
             )
         };
@@ -157,7 +157,7 @@ mod tests {
         let e = err(&d, None);
         assert_eq!(
             e,
-            "two.xml: the scene's 2 cameras ask for 21474836480 samples in all, more than the limit of 17179869184; \
+            "two.xml: the scene's 2 cameras ask for 19327352832 samples in all, more than the limit of 17179869184; \
              --no-limits lifts the limits"
         );
         check_limits(&d, Some(1), &SceneLimits::default()).unwrap();

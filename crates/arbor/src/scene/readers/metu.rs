@@ -426,6 +426,42 @@ mod tests {
         assert_eq!(e.to_string(), "t.xml:1:181: MeshInstance 7: unknown base mesh id '9'");
     }
 
+    /// A camera with `extra` elements, the first of them at column 219.
+    fn camera(extra: &str) -> String {
+        format!(
+            "<Cameras><Camera id=\"1\"><Position>0 0 0</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>\
+             <NearPlane>-1 1 -1 1</NearPlane><NearDistance>1</NearDistance><ImageResolution>4 4</ImageResolution>\
+             <ImageName>a.png</ImageName>{extra}</Camera></Cameras>"
+        )
+    }
+
+    #[test]
+    fn metu_num_samples_become_the_nearest_square_with_a_warning() {
+        for (n, used) in [(1, 1), (4, 4), (9, 9), (900, 900), (2, 1), (3, 4), (10, 9), (12, 9), (13, 16), (14, 16)] {
+            let d = read_xml(&camera(&format!("<NumSamples>{n}</NumSamples>"))).unwrap();
+            assert_eq!(d.cameras[0].num_samples, used, "NumSamples {n}");
+            assert_eq!(d.warnings.is_empty(), n == used, "NumSamples {n}: {:?}", d.warnings);
+        }
+        let d = read_xml(&camera("<NumSamples>10</NumSamples>")).unwrap();
+        assert_eq!(d.warnings, ["t.xml:1:219: Camera 1: NumSamples 10 is not a perfect square; using 9 (3x3)"]);
+        let d = read_xml(&camera("<NumSamples>14</NumSamples>")).unwrap();
+        assert_eq!(d.warnings, ["t.xml:1:219: Camera 1: NumSamples 14 is not a perfect square; using 16 (4x4)"]);
+        // The largest count keeps within u32: 65535² rather than 65536².
+        let d = read_xml(&camera(&format!("<NumSamples>{}</NumSamples>", u32::MAX))).unwrap();
+        assert_eq!(d.cameras[0].num_samples, 65535 * 65535);
+        assert_eq!(read_xml(&camera("")).unwrap().cameras[0].num_samples, 1);
+    }
+
+    #[test]
+    fn metu_num_samples_below_one_are_errors() {
+        let e = read_xml(&camera("<NumSamples>0</NumSamples>")).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: Camera 1: NumSamples 0 must be at least 1");
+        let e = read_xml(&camera("<NumSamples>-4</NumSamples>")).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: Camera 1: NumSamples -4 must be at least 1");
+        let e = read_xml(&camera("<NumSamples>2.5</NumSamples>")).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: <NumSamples>: malformed integer '2.5'");
+    }
+
     #[test]
     fn metu_spherical_light_names_a_file_or_an_image_id() {
         let images = "<Textures><Images><Image id=\"1\">a.png</Image><Image id=\"2\">sky.exr</Image></Images>\

@@ -39,7 +39,7 @@ impl Reader<'_> {
             return Err(self.err(name_node, "<ImageName>: empty file name"));
         }
         let num_samples = match self.one(c, "NumSamples") {
-            Some(n) => n.uint(p)?.max(1),
+            Some(n) => self.num_samples(n, &id)?,
             None => 1,
         };
         let (gaze, window) = if look_at {
@@ -91,5 +91,26 @@ impl Reader<'_> {
             lens,
             loc: c.loc(p),
         })
+    }
+
+    /// `NumSamples`: at least 1, and a perfect square, so that the jittered grid of a pixel is square
+    /// (the assignment texts only use squares). Another count becomes the nearest square,
+    /// `round(sqrt n)²`, with a warning; for integers that is also the square nearest to `n`.
+    fn num_samples(&mut self, n: &Node, id: &str) -> Result<u32> {
+        let p = self.path;
+        if let Ok(v) = n.trimmed().parse::<i64>() {
+            if v < 1 {
+                return Err(self.err(n, format!("Camera {id}: NumSamples {v} must be at least 1")));
+            }
+        }
+        let v = n.uint(p)?;
+        // 65535² is the largest square that fits a u32.
+        let side = ((v as f64).sqrt().round() as u32).clamp(1, 65535);
+        let square = side * side;
+        if square != v {
+            let msg = format!("Camera {id}: NumSamples {v} is not a perfect square; using {square} ({side}x{side})");
+            self.notes.plain(n.loc(p), msg);
+        }
+        Ok(square)
     }
 }
