@@ -81,10 +81,18 @@ fn catalogue() -> Vec<Row> {
     render("mesh_nan_binary_ply.xml", 3, "error: nan_binary.ply: byte 193: vertex 2: non-finite y (NaN)\n"),
     render("mesh_inf_obj.xml", 3, "error: inf.obj:3:5: non-finite coordinate `inf`\n"),
     render("mesh_inf_off.xml", 3, "error: inf.off:5:5: non-finite coordinate `-inf`\n"),
-    // Camera values outside their domain.
+    // Camera and light values outside their domain (non-finite ones are refused like any number).
     render("num_samples_zero.xml", 3, "error: num_samples_zero.xml:10:13: Camera 1: NumSamples 0 must be at least 1\n"),
     render("num_samples_negative.xml", 3, "error: num_samples_negative.xml:10:13: Camera 1: NumSamples -9 must be at least 1\n"),
     render("num_samples_not_square.xml", 0, "warning: num_samples_not_square.xml:10:13: Camera 1: NumSamples 10 is not a perfect square; using 9 (3x3)\n"),
+    render("aperture_negative.xml", 3, "error: aperture_negative.xml:11:13: Camera 1: ApertureSize -0.5 is negative (0 is a pinhole)\n"),
+    render("aperture_inf.xml", 3, "error: aperture_inf.xml:11:13: <ApertureSize>: non-finite number 'inf'\n"),
+    render("focus_distance_zero.xml", 3, "error: focus_distance_zero.xml:10:13: Camera 1: FocusDistance 0 must be positive\n"),
+    render("focus_distance_negative.json", 3, "error: focus_distance_negative.json:13:9: Camera 1: FocusDistance -5 must be positive\n"),
+    render("area_light_zero_size.xml", 3, "error: area_light_zero_size.xml:18:13: AreaLight 1: Size 0 must be positive\n"),
+    render("area_light_negative_size.xml", 3, "error: area_light_negative_size.xml:18:13: AreaLight 1: Size -1 must be positive\n"),
+    render("area_light_zero_normal.xml", 3, "error: area_light_zero_normal.xml:17:13: <Normal>: zero vector\n"),
+    render("area_light_nan_radiance.xml", 3, "error: area_light_nan_radiance.xml:19:13: <Radiance>: non-finite number 'nan'\n"),
     // Indices out of range.
     render("face_index_out_of_range.xml", 3, "error: face_index_out_of_range.xml:29:44: Mesh 1: vertex index 9 out of range (VertexData has 3 vertices, numbered from 1)\n"),
     render("face_index_zero.xml", 3, "error: face_index_zero.xml:29:44: Mesh 1: vertex index 0 out of range (VertexData has 3 vertices, numbered from 1)\n"),

@@ -109,9 +109,9 @@ pub struct Window {
 /// A thin-lens aperture for depth of field.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lens {
-    /// Side of the square aperture (`ApertureSize`).
+    /// Side of the square aperture (`ApertureSize`), positive.
     pub aperture: f32,
-    /// Distance to the plane in focus (`FocusDistance`).
+    /// Distance to the plane in focus (`FocusDistance`), positive.
     pub focus_distance: f32,
 }
 
@@ -142,7 +142,7 @@ pub struct CameraDesc {
     pub num_samples: u32,
     /// Camera transform (applied to position, gaze and up).
     pub transform: Transform,
-    /// Depth of field, when the file asks for it.
+    /// Depth of field, when the file asks for it with a non-zero aperture.
     pub lens: Option<Lens>,
     /// Where the camera is defined.
     pub loc: Location,
@@ -158,7 +158,7 @@ pub enum LightDesc {
         /// Intensity.
         intensity: Color,
     },
-    /// A square of side `size` centred at `position` facing `normal`, emitting `radiance`.
+    /// A square of side `size` (positive) centred at `position` facing `normal`, emitting `radiance`.
     Area {
         /// Centre.
         position: Vec3,

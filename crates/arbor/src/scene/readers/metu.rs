@@ -293,12 +293,7 @@ impl Reader<'_> {
                     position: self.req(n, "Position")?.vec3(p)?,
                     intensity: self.req(n, "Intensity")?.vec3(p)?,
                 },
-                "AreaLight" => LightDesc::Area {
-                    position: self.req(n, "Position")?.vec3(p)?,
-                    normal: self.unit(n, "Normal")?,
-                    size: self.req(n, "Size")?.float(p)?,
-                    radiance: self.req(n, "Radiance")?.vec3(p)?,
-                },
+                "AreaLight" => self.area_light(n)?,
                 "DirectionalLight" => LightDesc::Directional {
                     direction: self.unit(n, "Direction")?,
                     radiance: self.req(n, "Radiance")?.vec3(p)?,
@@ -340,6 +335,25 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// An `AreaLight`: a square of positive side whose area is a finite number, facing a non-zero
+    /// normal (the number reader already refuses non-finite coordinates and radiance).
+    fn area_light(&mut self, n: &Node) -> Result<LightDesc> {
+        let p = self.path;
+        let position = self.req(n, "Position")?.vec3(p)?;
+        let normal = self.unit(n, "Normal")?;
+        let s = self.req(n, "Size")?;
+        let size = s.float(p)?;
+        let name = || format!("AreaLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));
+        if size <= 0.0 {
+            return Err(self.err(s, format!("{}: Size {size} must be positive", name())));
+        }
+        if !(size * size).is_finite() {
+            return Err(self.err(s, format!("{}: Size {size} is too large (its area is not a finite number)", name())));
+        }
+        let radiance = self.req(n, "Radiance")?.vec3(p)?;
+        Ok(LightDesc::Area { position, normal, size, radiance })
+    }
+
     /// The child `name` of `n` as a unit vector.
     fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
         let c = self.req(n, name)?;
@@ -355,7 +369,7 @@ mod objects;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::desc::ShapeDesc;
+    use crate::scene::desc::{Lens, ShapeDesc};
     use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
@@ -460,6 +474,59 @@ mod tests {
         assert_eq!(e.to_string(), "t.xml:1:219: Camera 1: NumSamples -4 must be at least 1");
         let e = read_xml(&camera("<NumSamples>2.5</NumSamples>")).unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:219: <NumSamples>: malformed integer '2.5'");
+    }
+
+    #[test]
+    fn metu_lens_must_be_finite_not_negative_and_focus_in_front() {
+        let lens = |f: &str, a: &str| {
+            read_xml(&camera(&format!("<FocusDistance>{f}</FocusDistance><ApertureSize>{a}</ApertureSize>")))
+        };
+        let d = lens("21", "1.5").unwrap();
+        assert_eq!(d.cameras[0].lens, Some(Lens { aperture: 1.5, focus_distance: 21.0 }));
+        // A zero aperture is a pinhole, whatever the focus distance.
+        assert_eq!(lens("21", "0").unwrap().cameras[0].lens, None);
+        assert_eq!(lens("0", "0").unwrap().cameras[0].lens, None);
+        let e = lens("21", "-1.5").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:252: Camera 1: ApertureSize -1.5 is negative (0 is a pinhole)");
+        let e = lens("0", "1.5").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: Camera 1: FocusDistance 0 must be positive");
+        let e = lens("-3", "0").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: Camera 1: FocusDistance -3 must be positive");
+        let e = lens("inf", "1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:219: <FocusDistance>: non-finite number 'inf'");
+        let e = lens("5", "NaN").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:251: <ApertureSize>: non-finite number 'NaN'");
+        let e = lens("5", "1e39").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:251: <ApertureSize>: out-of-range number '1e39'");
+    }
+
+    #[test]
+    fn metu_area_light_needs_a_positive_size_a_normal_and_finite_radiance() {
+        let area = |normal: &str, size: &str, radiance: &str| {
+            read_xml(&format!(
+                "<Lights><AreaLight id=\"2\"><Position>0 0 0</Position><Normal>{normal}</Normal>\
+                 <Size>{size}</Size><Radiance>{radiance}</Radiance></AreaLight></Lights>"
+            ))
+        };
+        let d = area("0 -2 0", "3", "1 2 3").unwrap();
+        let want =
+            LightDesc::Area { position: Vec3::ZERO, normal: -Vec3::Y, size: 3.0, radiance: Vec3::new(1.0, 2.0, 3.0) };
+        assert_eq!(d.lights, [want]);
+        let e = area("0 -1 0", "0", "1 1 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:83: AreaLight 2: Size 0 must be positive");
+        let e = area("0 -1 0", "-2", "1 1 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:83: AreaLight 2: Size -2 must be positive");
+        let e = area("0 -1 0", "1e20", "1 1 1").unwrap_err();
+        let msg = "t.xml:1:83: AreaLight 2: Size 100000000000000000000 is too large (its area is not a finite number)";
+        assert_eq!(e.to_string(), msg);
+        let e = area("0 -1 0", "inf", "1 1 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:83: <Size>: non-finite number 'inf'");
+        let e = area("0 0 0", "1", "1 1 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:60: <Normal>: zero vector");
+        let e = area("0 nan 0", "1", "1 1 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:60: <Normal>: non-finite number 'nan'");
+        let e = area("0 -1 0", "1", "1 Infinity 1").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:97: <Radiance>: non-finite number 'Infinity'");
     }
 
     #[test]

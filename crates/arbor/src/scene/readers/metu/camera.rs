@@ -67,7 +67,7 @@ impl Reader<'_> {
         }
         let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
             (None, None) => None,
-            (Some(f), Some(a)) => Some(Lens { aperture: a.float(p)?, focus_distance: f.float(p)? }),
+            (Some(f), Some(a)) => self.lens(f, a, &id)?,
             (Some(_), None) => return Err(self.err(c, "<Camera>: missing <ApertureSize>")),
             (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
         };
@@ -112,5 +112,21 @@ impl Reader<'_> {
             self.notes.plain(n.loc(p), msg);
         }
         Ok(square)
+    }
+
+    /// The thin lens of `FocusDistance` `f` and `ApertureSize` `a`; none (a pinhole) when the aperture
+    /// is 0. Both must be finite (the number reader sees to that) and not negative, and the plane in
+    /// focus must lie in front of a real lens.
+    fn lens(&mut self, f: &Node, a: &Node, id: &str) -> Result<Option<Lens>> {
+        let p = self.path;
+        let (aperture, focus_distance) = (a.float(p)?, f.float(p)?);
+        if aperture < 0.0 {
+            return Err(self.err(a, format!("Camera {id}: ApertureSize {aperture} is negative (0 is a pinhole)")));
+        }
+        if focus_distance < 0.0 || (focus_distance == 0.0 && aperture > 0.0) {
+            let msg = format!("Camera {id}: FocusDistance {focus_distance} must be positive");
+            return Err(self.err(f, msg));
+        }
+        Ok((aperture > 0.0).then_some(Lens { aperture, focus_distance }))
     }
 }
