@@ -369,7 +369,7 @@ mod objects;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::desc::{Lens, ShapeDesc};
+    use crate::scene::desc::{Lens, MaterialKind, ShapeDesc};
     use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
@@ -527,6 +527,64 @@ mod tests {
         assert_eq!(e.to_string(), "t.xml:1:60: <Normal>: non-finite number 'nan'");
         let e = area("0 -1 0", "1", "1 Infinity 1").unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:97: <Radiance>: non-finite number 'Infinity'");
+    }
+
+    #[test]
+    fn metu_legacy_refraction_index_of_an_opaque_material_warns_only_where_it_could_matter() {
+        let material = |id: u32, extra: &str| {
+            format!(
+                "<Material id=\"{id}\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                 <DiffuseReflectance>1 1 1</DiffuseReflectance>{extra}</Material>"
+            )
+        };
+        let body = format!(
+            "<Materials>{}{}{}{}</Materials>",
+            material(1, "<Transparency>0 0 0</Transparency><RefractionIndex>1.5</RefractionIndex>"),
+            material(2, "<RefractionIndex>1</RefractionIndex>"),
+            material(3, "<Transparency>0.5 0.5 0.5</Transparency><RefractionIndex>1.5</RefractionIndex>"),
+            material(4, "<RefractionIndex>1.5</RefractionIndex>"),
+        );
+        let brdf = "<Material id=\"5\" BRDF=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                    <DiffuseReflectance>1 1 1</DiffuseReflectance><RefractionIndex>0.37</RefractionIndex></Material>";
+        let body = body.replace("</Materials>", &format!("{brdf}</Materials>"));
+        let d = read_xml(&body).unwrap();
+        let kinds: Vec<_> = d.materials.iter().map(|m| m.kind.clone()).collect();
+        let glass = MaterialKind::Transparent { eta: 1.5, transparency: Vec3::splat(0.5), mirror: Vec3::ZERO };
+        let plain = MaterialKind::BlinnPhong;
+        assert_eq!(kinds, [plain.clone(), plain.clone(), glass, plain.clone(), plain]);
+        // Material 5's index belongs to its BRDF, which is reported, and so is the index.
+        assert_eq!(
+            d.warnings,
+            [
+                "t.xml:1:674: Material 4: RefractionIndex 1.5 has no effect without a non-zero <Transparency>",
+                "t.xml:1:740: attribute BRDF of <Material>: BRDF models are not supported; ignored",
+                "t.xml:1:841: <RefractionIndex> in <Material> ignored (unknown or unused here)",
+            ]
+        );
+        let e = read_xml(&body.replace(">1.5</Refr", ">x</Refr")).unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:162: <RefractionIndex>: malformed number 'x'");
+    }
+
+    #[test]
+    fn metu_untyped_mirror_reflectance_of_a_typed_file_warns_only_where_it_could_matter() {
+        let body = |depth: u32, reflectance: &str| {
+            format!(
+                "<MaxRecursionDepth>{depth}</MaxRecursionDepth><Materials>{}\
+                 <Material id=\"2\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                 <DiffuseReflectance>1 1 1</DiffuseReflectance><MirrorReflectance>{reflectance}</MirrorReflectance>\
+                 </Material><Material id=\"3\" type=\"mirror\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                 <DiffuseReflectance>1 1 1</DiffuseReflectance><MirrorReflectance>1 1 1</MirrorReflectance>\
+                 </Material></Materials>",
+                &MATERIAL["<Materials>".len()..MATERIAL.len() - "</Materials>".len()]
+            )
+        };
+        let d = read_xml(&body(6, "0.5 0.5 0.5")).unwrap();
+        assert_eq!(d.materials[1].kind, MaterialKind::BlinnPhong);
+        let msg = "t.xml:1:288: <MirrorReflectance>: a material without type=\"mirror\" or \"conductor\" does not \
+                   reflect (as in the official renderers); ignored";
+        assert_eq!(d.warnings, [msg]);
+        assert_eq!(read_xml(&body(6, "0 0 0")).unwrap().warnings, Vec::<String>::new());
+        assert_eq!(read_xml(&body(0, "0.5 0.5 0.5")).unwrap().warnings, Vec::<String>::new());
     }
 
     #[test]

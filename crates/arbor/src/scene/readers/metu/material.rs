@@ -1,6 +1,11 @@
 //! METU materials: Blinn-Phong terms plus the `type` (mirror, conductor, dielectric), or for untyped
 //! pre-2020 materials the kind the present elements imply (non-zero `Transparency` is glass, else
 //! non-zero `MirrorReflectance` a mirror).
+//!
+//! An element that a material's kind leaves without effect is accepted in silence where no reading of the
+//! file could make it matter, and reported where it could: a legacy opaque material's `RefractionIndex`
+//! (the 2019 template writes `Transparency 0 0 0` and `RefractionIndex 1` into every material), and the
+//! `MirrorReflectance` of an untyped material in a typed file (zero, or with no recursion).
 
 use super::Reader;
 use crate::math::Color;
@@ -52,18 +57,25 @@ impl Reader<'_> {
                 let msg = format!("Material {id}: unknown type '{t}' (expected mirror, conductor or dielectric)");
                 return Err(Error::input(a.loc(p), msg));
             }
-            None if !self.legacy => MaterialKind::BlinnPhong,
+            None if !self.legacy => {
+                self.untyped_mirror_reflectance(m)?;
+                MaterialKind::BlinnPhong
+            }
             None => {
                 // Pre-2020 files have no type; the elements present say what the material is.
                 let mirror = color(self, "MirrorReflectance")?.unwrap_or(Color::ZERO);
+                let transparency_given = m.child("Transparency").is_some();
                 let transparency = color(self, "Transparency")?.unwrap_or(Color::ZERO);
                 if transparency != Color::ZERO {
                     let eta = float(self, "RefractionIndex")?;
                     MaterialKind::Transparent { eta, transparency, mirror }
-                } else if mirror != Color::ZERO {
-                    MaterialKind::Mirror { reflectance: mirror }
                 } else {
-                    MaterialKind::BlinnPhong
+                    self.opaque_refraction_index(m, &id, transparency_given)?;
+                    if mirror != Color::ZERO {
+                        MaterialKind::Mirror { reflectance: mirror }
+                    } else {
+                        MaterialKind::BlinnPhong
+                    }
                 }
             }
         };
@@ -85,6 +97,41 @@ impl Reader<'_> {
             None => 0.0,
         };
         Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, roughness, kind })
+    }
+
+    /// A legacy opaque material's `RefractionIndex`: it has no effect (only a non-zero `Transparency`
+    /// makes a legacy material refract), so it is accepted in silence where it could not matter: beside
+    /// an explicit zero `Transparency` (the 2019 files' template), or when it is 1. Otherwise the file
+    /// may have meant glass, and is told. A material with a `BRDF` (Torrance-Sparrow's Fresnel term reads
+    /// the index) is left alone: its index stays reported as unused, like the BRDF itself.
+    fn opaque_refraction_index(&mut self, m: &Node, id: &str, transparency_given: bool) -> Result<()> {
+        if m.attrs.iter().any(|a| a.name == "BRDF") {
+            return Ok(());
+        }
+        let Some(r) = self.one(m, "RefractionIndex") else {
+            return Ok(());
+        };
+        let eta = r.float(self.path)?;
+        if !transparency_given && eta != 1.0 {
+            let msg = format!("Material {id}: RefractionIndex {eta} has no effect without a non-zero <Transparency>");
+            self.notes.plain(r.loc(self.path), msg);
+        }
+        Ok(())
+    }
+
+    /// `MirrorReflectance` on an untyped material of a typed (post-2020) file: the material stays plain
+    /// Blinn-Phong, as in the official renderers, so the element has no effect. Silent where it could
+    /// not matter (zero reflectance, or no recursion at all); otherwise one warning for the file.
+    fn untyped_mirror_reflectance(&mut self, m: &Node) -> Result<()> {
+        let Some(r) = self.one(m, "MirrorReflectance") else {
+            return Ok(());
+        };
+        if r.vec3(self.path)? != Color::ZERO && self.desc.max_depth > 0 {
+            let what = "a material without type=\"mirror\" or \"conductor\" does not reflect (as in the official \
+                        renderers); ignored";
+            self.notes.feature(r.loc(self.path), "<MirrorReflectance>", what);
+        }
+        Ok(())
     }
 
     /// The material an object names, as an index.
