@@ -6,6 +6,8 @@
 //!   vertices they use (0-based), a sphere's `Center` and a plane's `Point` are vertex ids;
 //! - `Transformations` lists named transforms (`t1 s2 r1 c1`) applied left to right;
 //! - a look-at camera's window is `top = NearDistance·tan(FovY/2)`, `right = top·width/height`;
+//! - `NumSamples` is a perfect square in every assignment file; another count becomes the nearest
+//!   square with a warning, so that the jittered grid stays square; `ApertureSize` 0 is a pinhole;
 //! - untyped (pre-2020) materials: a non-zero `Transparency` means glass, else a non-zero
 //!   `MirrorReflectance` means a mirror. Only legacy files follow this rule: XML files in which no
 //!   material has a `type`. Files that type their materials, and the 2025 JSON form always, keep
