@@ -93,6 +93,9 @@ fn catalogue() -> Vec<Row> {
     render("area_light_negative_size.xml", 3, "error: area_light_negative_size.xml:18:13: AreaLight 1: Size -1 must be positive\n"),
     render("area_light_zero_normal.xml", 3, "error: area_light_zero_normal.xml:17:13: <Normal>: zero vector\n"),
     render("area_light_nan_radiance.xml", 3, "error: area_light_nan_radiance.xml:19:13: <Radiance>: non-finite number 'nan'\n"),
+    render("roughness_negative.xml", 3, "error: roughness_negative.xml:21:13: Material 1: negative roughness -0.2\n"),
+    render("motion_blur_nan.xml", 3, "error: motion_blur_nan.xml:29:82: <MotionBlur>: non-finite number 'nan'\n"),
+    render("motion_blur_short.xml", 3, "error: motion_blur_short.xml:29:82: <MotionBlur>: expected 3 numbers, found 2\n"),
     // Indices out of range.
     render("face_index_out_of_range.xml", 3, "error: face_index_out_of_range.xml:29:44: Mesh 1: vertex index 9 out of range (VertexData has 3 vertices, numbered from 1)\n"),
     render("face_index_zero.xml", 3, "error: face_index_zero.xml:29:44: Mesh 1: vertex index 0 out of range (VertexData has 3 vertices, numbered from 1)\n"),
