@@ -10,7 +10,7 @@
 //! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
 //! lights their [`crate::light::Light::sample`], never the description.
 
-use super::offset::spawn_origin;
+use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
 use crate::material::{beer, blinn_phong};
 use crate::math::{Color, Ray};
@@ -88,12 +88,7 @@ impl<'a> Whitted<'a> {
                 continue;
             }
             *count += scene.shadows as u64;
-            let shadow = if ls.dist.is_finite() {
-                Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
-            } else {
-                Ray::new(shadow_origin, ls.wi)
-            };
-            let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
+            let (shadow, t_max) = shadow_ray(scene.offset, shadow_origin, s.p, &ls);
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
