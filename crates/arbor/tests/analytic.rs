@@ -109,6 +109,44 @@ fn analytic_light_behind_occluder_leaves_only_ambient() {
 }
 
 #[test]
+fn analytic_back_face_is_lit_by_the_light_in_front_of_it() {
+    // A square at z = 0 whose stored normal faces away from the camera. The METU renderers shade it with
+    // that normal from both sides: the light in front of it (z = -4) lights its back, seen by the
+    // camera; a light on the camera's side does not. Turning normals to the ray swaps the two.
+    let m = material(0.25, 0.5, MaterialKind::BlinnPhong);
+    let light = |z: f32| LightDesc::Point { position: Vec3::new(0.0, 0.0, z), intensity: Color::splat(1600.0) };
+    let back = |z: f32, flip: bool| {
+        let mut desc = scene(vec![m.clone()], vec![object(quad(0.0, 5.0, false), 0)], vec![light(z)], 0);
+        desc.flip_back_faces = flip;
+        pixel(desc)
+    };
+    let (ambient, lit) = (Color::splat(25.0), Color::splat(25.0 + 0.5 * 1600.0 / 16.0));
+    assert_close(back(-4.0, false), lit);
+    assert_close(back(4.0, false), ambient);
+    assert_close(back(-4.0, true), ambient);
+    assert_close(back(4.0, true), lit);
+}
+
+#[test]
+fn analytic_mirror_seen_from_behind_reflects_from_its_front() {
+    // A mirror at z = 0 whose stored normal faces away from the camera, a wall at z = -20 in front of
+    // it, nothing behind the camera. The METU renderers offset the reflected ray along the stored
+    // normal: it starts in front of the mirror, meets the mirror's front face right away and reflects
+    // from there to the wall: mirror ambient + km (mirror ambient + km * wall ambient). Turned to the
+    // ray, the reflection leaves towards the camera and sees nothing.
+    let mirror = material(0.1, 0.0, MaterialKind::Mirror { reflectance: Color::splat(0.5) });
+    let wall = material(0.8, 0.0, MaterialKind::BlinnPhong);
+    let seen = |flip: bool| {
+        let objects = vec![object(quad(0.0, 5.0, false), 0), object(quad(-20.0, 50.0, true), 1)];
+        let mut desc = scene(vec![mirror.clone(), wall.clone()], objects, vec![], 2);
+        desc.flip_back_faces = flip;
+        pixel(desc)
+    };
+    assert_close(seen(false), Color::splat(10.0 + 0.5 * (10.0 + 0.5 * 80.0)));
+    assert_close(seen(true), Color::splat(10.0));
+}
+
+#[test]
 fn analytic_mirror_returns_what_is_behind_the_camera() {
     // A mirror at z = 0 facing the camera; behind the camera at z = 20 a wall facing it, lit only by
     // ambient light. Seen: mirror ambient + km * wall ambient.

@@ -6,14 +6,16 @@
 //! Every ray of a camera sample keeps its time (motion blur). Rough materials send their lobes'
 //! rays off the ideal directions ([`crate::material::perturb`]), one random choice per lobe.
 //!
-//! Secondary ray origins are pushed off the surface to the side the new ray leaves from, so a ray never
-//! re-hits its own surface: by the scene's `ShadowRayEpsilon` or by the hit point's floating-point error
-//! bound ([`super::offset::spawn_origin`] decides).
+//! Secondary ray origins are pushed off the surface, by the scene's `ShadowRayEpsilon` or by the hit
+//! point's floating-point error bound ([`super::offset::spawn_origin`] decides): to the side the new ray
+//! leaves from, except in METU scenes, whose renderers never turn a surface's normal towards the ray:
+//! there a surface shows the side of its stored normal from both sides, and its shadow and mirror rays
+//! leave from that side (glass's lobes still leave on the side they go to).
 //!
 //! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
 //! lights their [`crate::light::Light::sample`], never the description.
 
-use super::offset::spawn_origin;
+use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
 use crate::material::{beer, blinn_phong, perturb};
 use crate::math::{Color, Ray};
@@ -75,9 +77,11 @@ impl<'a> Whitted<'a> {
         let s = scene.surface(ray, &hit);
         let m = scene.material(&s);
         let d = ray.dir;
-        // Shade the side the ray arrives on: both normals are flipped towards it.
         let front = d.dot(s.ng) < 0.0;
-        let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
+        // The side the surface shows: the one the ray arrives on, or (the METU renderers) always its
+        // stored normal's, so a back face is lit by the lights in front of it (windmill_smooth's and
+        // grass_desert's unculled references).
+        let (ng, ns) = if front || !scene.flip_back_faces { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
 
         // A refractive surface hit from inside only refracts and reflects: its ambient and Blinn-Phong
         // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
@@ -91,13 +95,8 @@ impl<'a> Whitted<'a> {
                 continue;
             }
             *count += scene.shadows as u64;
-            let shadow = if ls.dist.is_finite() {
-                Ray::new(shadow_origin, s.p + ls.wi * ls.dist - shadow_origin)
-            } else {
-                Ray::new(shadow_origin, ls.wi)
-            }
-            .with_time(ray.time);
-            let t_max = if ls.dist.is_finite() { 1.0 } else { f32::INFINITY };
+            let (shadow, t_max) = shadow_ray(scene.offset, shadow_origin, s.p, &ls);
+            let shadow = shadow.with_time(ray.time);
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
@@ -113,7 +112,12 @@ impl<'a> Whitted<'a> {
                     continue;
                 }
                 let dir = if m.roughness > 0.0 { perturb(lobe.dir, m.roughness, rng.next_2d()) } else { lobe.dir };
-                let origin = spawn_origin(scene.offset, &s, dir);
+                // Glass's lobes leave on the side they go to (into or out of it). A mirror's leave on
+                // the side the surface shows, like its shadow rays: the METU renderers offset them
+                // along the stored normal even when they head the other way (spheres_mirror,
+                // grass_desert); with normals turned to the ray, that is the lobe's own side.
+                let side = if m.transmits() || scene.flip_back_faces { dir } else { ng };
+                let origin = spawn_origin(scene.offset, &s, side);
                 // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
                 // a reflected one stays in whatever medium it was in.
                 let next_inside = match (lobe.transmitted, front) {

@@ -55,6 +55,7 @@ impl Scene {
             radiance_scale: desc.radiance_scale,
             max_depth: desc.max_depth,
             shadows: desc.shadows,
+            flip_back_faces: desc.flip_back_faces,
             cull_backfaces: desc.cull_backfaces,
             offset,
             build_time,

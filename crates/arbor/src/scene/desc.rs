@@ -34,6 +34,11 @@ pub struct SceneDesc {
     pub max_depth_loc: Option<Location>,
     /// Whether lights are tested for occlusion. The NYU assignment-4 renderer shades without shadow rays.
     pub shadows: bool,
+    /// Whether a surface hit from behind has its normals turned towards the ray (shaded as a front).
+    /// The METU renderers never turn them: every hit is shaded, and its shadow and mirror rays leave,
+    /// on the side of its stored normal (counter-clockwise winding, outward for spheres), so a back face
+    /// is lit by the lights in front of it. NYU scenes turn them.
+    pub flip_back_faces: bool,
     /// The scene's own back-face culling choice for primary rays (`BackfaceCulling`), if it makes one.
     pub cull_backfaces: Option<bool>,
     /// One image per camera.
@@ -68,6 +73,7 @@ impl SceneDesc {
             max_depth: 0,
             max_depth_loc: None,
             shadows: true,
+            flip_back_faces: false,
             cull_backfaces: None,
             cameras: Vec::new(),
             ambient: Color::ZERO,

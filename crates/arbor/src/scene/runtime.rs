@@ -41,6 +41,9 @@ pub struct Scene {
     pub max_depth: u32,
     /// Whether lights are tested for occlusion.
     pub shadows: bool,
+    /// Whether a surface hit from behind has its normals turned towards the ray; if not, it is shaded,
+    /// and its shadow and mirror rays leave, on the side of its stored normal.
+    pub flip_back_faces: bool,
     /// The scene's own back-face culling choice for camera rays, if it makes one.
     pub cull_backfaces: Option<bool>,
     /// Where secondary rays start.

@@ -45,6 +45,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
     desc.offset = OffsetRule::ErrorBound;
     desc.max_depth = 0;
     desc.shadows = false;
+    desc.flip_back_faces = true;
     let mut warn = Vec::new();
     if let Some(scene) = top.get("Scene") {
         let scene = Obj::new(&scene.value, "Scene", path)?;
