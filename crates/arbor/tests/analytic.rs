@@ -40,6 +40,7 @@ fn object(shape: ShapeDesc, material: usize) -> ObjectDesc {
         shape,
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
+        textures: Vec::new(),
         loc: Location::file("test"),
     }
 }

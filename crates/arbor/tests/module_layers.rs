@@ -37,6 +37,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("camera", 3),
     ("light", 3),
     ("material", 3),
+    ("texture", 3),
     ("scene::geometry", 3),
     ("scene::runtime", 3),
     // The build step: description -> runtime scene, loading assets.

@@ -29,7 +29,15 @@ impl Lcg {
 }
 
 fn object(shape: ShapeDesc, transform: Transform) -> ObjectDesc {
-    ObjectDesc { name: "o".into(), material: 0, shape, transform, motion: Vec3::ZERO, loc: Location::file("test") }
+    ObjectDesc {
+        name: "o".into(),
+        material: 0,
+        shape,
+        transform,
+        motion: Vec3::ZERO,
+        textures: Vec::new(),
+        loc: Location::file("test"),
+    }
 }
 
 fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {

@@ -24,7 +24,15 @@ fn quad() -> Arc<TriangleMesh> {
 }
 
 fn object(name: &str, shape: ShapeDesc, transform: Transform) -> ObjectDesc {
-    ObjectDesc { name: name.into(), material: 0, shape, transform, motion: Vec3::ZERO, loc: Location::file("test") }
+    ObjectDesc {
+        name: name.into(),
+        material: 0,
+        shape,
+        transform,
+        motion: Vec3::ZERO,
+        textures: Vec::new(),
+        loc: Location::file("test"),
+    }
 }
 
 fn desc(objects: Vec<ObjectDesc>) -> SceneDesc {

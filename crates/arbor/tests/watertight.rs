@@ -179,6 +179,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
         shape,
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
+        textures: Vec::new(),
         loc: Location::file("test"),
     };
     desc.objects.push(object(ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false }));

@@ -110,6 +110,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
         shape: ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false },
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
+        textures: Vec::new(),
         loc: Location::file(source),
     });
     desc

@@ -17,7 +17,7 @@
 
 use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
-use crate::material::{beer, blinn_phong, perturb};
+use crate::material::{beer, blinn_phong, perturb, Material};
 use crate::math::{Color, Ray};
 use crate::sampler::Rng;
 use crate::scene::Scene;
@@ -74,8 +74,21 @@ impl<'a> Whitted<'a> {
         let Some(hit) = hit else {
             return self.miss(ray, depth);
         };
-        let s = scene.surface(ray, &hit);
+        let mut s = scene.surface(ray, &hit);
         let m = scene.material(&s);
+        // Textures replace the Blinn-Phong terms and the shading normal; the specular layer stays.
+        let textured = scene.textured(ray, &hit, &mut s);
+        if let Some(c) = textured.and_then(|t| t.replace_all) {
+            return c;
+        }
+        let own;
+        let terms = match textured {
+            Some(t) => {
+                own = Material { ambient: t.ambient, diffuse: t.diffuse, specular: t.specular, layer: None, ..*m };
+                &own
+            }
+            None => m,
+        };
         let d = ray.dir;
         let front = d.dot(s.ng) < 0.0;
         // The side the surface shows: the one the ray arrives on, or (the METU renderers) always its
@@ -86,7 +99,7 @@ impl<'a> Whitted<'a> {
         // A refractive surface hit from inside only refracts and reflects: its ambient and Blinn-Phong
         // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
         let local = front || !m.transmits();
-        let mut color = if local { m.ambient * scene.ambient } else { Color::ZERO };
+        let mut color = if local { terms.ambient * scene.ambient } else { Color::ZERO };
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
         let shadow_origin = spawn_origin(scene.offset, &s, ng);
         for light in scene.lights.iter().filter(|_| local) {
@@ -100,7 +113,7 @@ impl<'a> Whitted<'a> {
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
-            color += blinn_phong(m, ns, ls.wi, -d) * ls.irradiance;
+            color += blinn_phong(terms, ns, ls.wi, -d) * ls.irradiance;
         }
 
         if depth < scene.max_depth && m.layer.is_some() {

@@ -26,7 +26,10 @@ use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
 use crate::math::Aabb;
+use crate::texture::Decal;
 use crate::{Error, Location, Result};
+
+mod textures;
 
 impl Scene {
     /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
@@ -38,6 +41,7 @@ impl Scene {
         };
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
+        let textures = textures::build_textures(&desc)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
         let offset = match desc.offset {
             OffsetRule::ShadowEpsilon => RayOffset::ShadowEpsilon(desc.shadow_epsilon),
@@ -47,6 +51,9 @@ impl Scene {
             geometry,
             materials: desc.materials.iter().map(build_material).collect(),
             object_materials: desc.objects.iter().map(|o| o.material).collect(),
+            background_texture: textures.iter().position(|t| t.decal == Decal::ReplaceBackground),
+            object_textures: desc.objects.iter().map(|o| o.textures.clone()).collect(),
+            textures,
             lights: desc.lights.iter().map(build_light).collect(),
             cameras: desc.cameras.iter().map(build_camera).collect(),
             environment,
@@ -210,9 +217,9 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
 }
 
 /// A mesh ready for rendering: smooth meshes get vertex normals (from the file, or averaged from the
-/// faces), flat ones none (the shader then uses the face normal).
+/// faces), flat ones none (the shader then uses the face normal); texture coordinates are kept.
 fn mesh_shape(mesh: &TriangleMesh, smooth: bool, spec: &AccelConfig) -> MeshShape {
-    let mut mesh = TriangleMesh { uvs: None, ..mesh.clone() };
+    let mut mesh = mesh.clone();
     if smooth {
         match &mut mesh.normals {
             Some(n) => n.iter_mut().for_each(|v| *v = v.normalize_or_zero()),

@@ -11,6 +11,9 @@ use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
 use crate::Location;
 
+mod texture;
+pub use texture::{DecalMode, ImageDesc, Interpolation, NoiseConversion, TextureDesc, TextureSource};
+
 /// A whole scene as described by its file.
 #[derive(Debug, Clone)]
 pub struct SceneDesc {
@@ -55,6 +58,10 @@ pub struct SceneDesc {
     pub environment: Option<PathBuf>,
     /// Where the file names `environment`, for the message when it cannot be read.
     pub environment_loc: Option<Location>,
+    /// Image files of texture maps, each once.
+    pub images: Vec<ImageDesc>,
+    /// Texture maps; objects refer to them by index.
+    pub textures: Vec<TextureDesc>,
     /// Things in the file that Arbor read but does not render (textures, motion blur...), one line each.
     pub warnings: Vec<String>,
 }
@@ -82,6 +89,8 @@ impl SceneDesc {
             objects: Vec::new(),
             environment: None,
             environment_loc: None,
+            images: Vec::new(),
+            textures: Vec::new(),
             warnings: Vec::new(),
         }
     }
@@ -297,6 +306,8 @@ pub struct ObjectDesc {
     /// World-space translation over the shutter interval (`MotionBlur`): the object is where `transform`
     /// puts it at time 0 and moved by `motion` at time 1; zero for a still object.
     pub motion: Vec3,
+    /// Indices into [`SceneDesc::textures`] of the maps on the object (an instance names its own).
+    pub textures: Vec<usize>,
     /// Where the object is defined.
     pub loc: Location,
 }

@@ -14,7 +14,8 @@ use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Color, Ray, Vec3};
+use crate::math::{Color, Ray, Transform, Vec2, Vec3};
+use crate::texture::{self, Shaded, TexPoint, Texture};
 
 /// A scene ready to render.
 pub struct Scene {
@@ -25,6 +26,12 @@ pub struct Scene {
     /// The index into [`Scene::materials`] of each object, in scene-file order (the `object` of a
     /// [`Surface`]).
     pub object_materials: Vec<usize>,
+    /// Texture maps; [`Scene::object_textures`] says which object has which.
+    pub textures: Vec<Texture>,
+    /// The indices into [`Scene::textures`] of each object's maps, in scene-file order (mostly empty).
+    pub object_textures: Vec<Vec<usize>>,
+    /// The texture that replaces the background of camera rays that miss, spanning the image plane.
+    pub background_texture: Option<usize>,
     /// Lights other than the ambient light and the environment.
     pub lights: Vec<Box<dyn Light>>,
     /// One image per camera.
@@ -146,6 +153,79 @@ impl Scene {
         };
         Surface { p, p_error, ng, ns, object, material: self.object_materials[object as usize] }
     }
+}
+
+impl Scene {
+    /// The Blinn-Phong terms of `s` after its object's textures, with `s.ns` replaced by the textured
+    /// normal (in world space); `None`, and `s` unchanged, for an object without textures.
+    pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface) -> Option<Shaded> {
+        let maps = self.object_textures.get(s.object as usize).filter(|t| !t.is_empty())?;
+        let (at, to_world) = self.tex_point(ray, hit, s);
+        let m = self.material(s);
+        let base = Shaded { ambient: m.ambient, diffuse: m.diffuse, specular: m.specular, n: at.n, replace_all: None };
+        let out = texture::apply(maps.iter().map(|&i| &self.textures[i]), base, &at);
+        if out.n != at.n {
+            let n = match to_world {
+                Some(t) => t.normal(out.n).normalize_or(s.ns),
+                None => out.n,
+            };
+            s.ns = if n.dot(s.ng) * s.ns.dot(s.ng) < 0.0 { -n } else { n };
+        }
+        Some(out)
+    }
+
+    /// The object-space sampling point of a hit and the object's transform (`None` for the identity).
+    fn tex_point(&self, ray: &Ray, hit: &Hit, s: &Surface) -> (TexPoint, Option<Transform>) {
+        let still = |motion: Vec3| s.p - motion * ray.time;
+        match self.geometry.objects.objects.get(hit.prim as usize) {
+            Some(o) => match &o.shape {
+                Shape::Mesh(m) => {
+                    let mesh = &m.mesh;
+                    let i = hit.sub as usize;
+                    let [a, b, c] = mesh.triangle(i);
+                    let w = Vec3::new(1.0 - hit.u - hit.v, hit.u, hit.v);
+                    let p = w.x * a + w.y * b + w.z * c;
+                    let (_, n) = triangle_normals(mesh, hit);
+                    let (uv, dpdu, dpdv) = match &mesh.uvs {
+                        Some(uvs) => {
+                            let [ia, ib, ic] = mesh.indices[i].map(|k| uvs[k as usize]);
+                            let uv = w.x * ia + w.y * ib + w.z * ic;
+                            let (d1, d2) = (ib - ia, ic - ia);
+                            let (e1, e2) = (b - a, c - a);
+                            let det = d1.x * d2.y - d2.x * d1.y;
+                            let inv = if det.abs() > f32::MIN_POSITIVE { 1.0 / det } else { 0.0 };
+                            (uv, (d2.y * e1 - d1.y * e2) * inv, (d1.x * e2 - d2.x * e1) * inv)
+                        }
+                        None => (Vec2::ZERO, Vec3::ZERO, Vec3::ZERO),
+                    };
+                    (TexPoint { uv, p, n, dpdu, dpdv }, o.transform)
+                }
+                Shape::Sphere(sp) => {
+                    let t = (!sp.transform.is_identity()).then_some(sp.transform);
+                    let local = t.map_or(still(o.motion), |t| t.inv.transform_point3(still(o.motion)));
+                    (sphere_tex_point(local, sp.center, sp.radius), t)
+                }
+            },
+            None => {
+                let plane = &self.geometry.planes[hit.prim as usize - self.geometry.objects.objects.len()];
+                let (p, n) = (still(plane.motion), plane.plane.normal);
+                (TexPoint { uv: Vec2::ZERO, p, n, dpdu: Vec3::ZERO, dpdv: Vec3::ZERO }, None)
+            }
+        }
+    }
+}
+
+/// Spherical texture coordinates of the point `p` of a sphere (CENG 795): with `r = p - center`,
+/// `u = (π - atan2(r.z, r.x)) / 2π`, `v = acos(r.y / radius) / π`; and the derivatives of `p` along them.
+fn sphere_tex_point(p: Vec3, center: Vec3, radius: f32) -> TexPoint {
+    use std::f32::consts::PI;
+    let r = p - center;
+    let theta = (r.y / radius).clamp(-1.0, 1.0).acos();
+    let phi = r.z.atan2(r.x);
+    let uv = Vec2::new((PI - phi) / (2.0 * PI), theta / PI);
+    let dpdu = 2.0 * PI * Vec3::new(r.z, 0.0, -r.x);
+    let dpdv = PI * Vec3::new(r.y * phi.cos(), -radius * theta.sin(), r.y * phi.sin());
+    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv }
 }
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal

@@ -23,7 +23,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::tree::{Node, Unused};
-use crate::math::{Mat4, Transform, Vec3};
+use crate::math::{Mat4, Transform, Vec2, Vec3};
 use crate::scene::desc::{LightDesc, SceneDesc};
 use crate::{Error, Location, Result};
 
@@ -52,6 +52,8 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
         transforms: HashMap::new(),
         materials: HashMap::new(),
         images: image_table(root),
+        texture_ids: HashMap::new(),
+        uvs: Vec::new(),
     };
     r.globals(root)?;
     if let Some(v) = r.one(root, "VertexData") {
@@ -131,6 +133,10 @@ struct Reader<'a> {
     materials: HashMap<String, usize>,
     /// `Textures/Images/Image` by id: the file name as written, for lights that name an image.
     images: HashMap<String, String>,
+    /// `TextureMap` ids, as indices into the description's textures.
+    texture_ids: HashMap<String, usize>,
+    /// `TexCoordData`, numbered from 1 like the vertices.
+    uvs: Vec<Vec2>,
     /// A pre-2020 file: untyped materials take their kind from the elements present.
     legacy: bool,
 }
@@ -221,10 +227,11 @@ impl Reader<'_> {
             self.desc.cull_backfaces = Some(n.boolean(p)?);
         }
         if let Some(n) = self.one(root, "TexCoordData") {
-            // Read for its syntax only: nothing Arbor renders uses texture coordinates.
-            n.floats(p)?;
+            self.tex_coord_data(n)?;
         }
-        self.unsupported(root, "Textures", "textures are");
+        if let Some(t) = self.one(root, "Textures") {
+            self.textures(t)?;
+        }
         self.unsupported(root, "BackgroundTexture", "background textures are");
         self.unsupported(root, "BRDFs", "BRDF models are");
         Ok(())
@@ -367,6 +374,7 @@ impl Reader<'_> {
 mod camera;
 mod material;
 mod objects;
+mod textures;
 
 #[cfg(test)]
 mod tests {
@@ -619,7 +627,10 @@ mod tests {
              <Texture>1</Texture></Sphere></Objects>"
         );
         let d = read_xml(&body).unwrap();
-        assert_eq!(d.warnings, ["t.xml:1:263: <Texture>: textures are not supported; ignored (2 occurrences)"]);
+        assert_eq!(
+            d.warnings,
+            ["t.xml:1:263: <Texture>: textures in the pre-2022 form are not supported; ignored (2 occurrences)"]
+        );
     }
 
     #[test]

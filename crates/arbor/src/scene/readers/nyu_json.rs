@@ -187,7 +187,15 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
     let mut all = vec!["Type", "Material"];
     all.extend_from_slice(known);
     o.unknown(&all, warn);
-    Ok(ObjectDesc { name, material, shape, transform: Transform::IDENTITY, motion: Vec3::ZERO, loc: o.loc(ty) })
+    Ok(ObjectDesc {
+        name,
+        material,
+        shape,
+        transform: Transform::IDENTITY,
+        motion: Vec3::ZERO,
+        textures: Vec::new(),
+        loc: o.loc(ty),
+    })
 }
 
 fn text_of(m: &Member) -> String {

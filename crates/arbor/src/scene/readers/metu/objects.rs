@@ -23,6 +23,7 @@ struct Pending<'n> {
     base_id: &'n Attr,
     reset: bool,
     has_material: bool,
+    has_textures: bool,
 }
 
 /// What a `MeshInstance` id names while instances are resolved.
@@ -53,7 +54,8 @@ impl Reader<'_> {
                 self.notes.feature(o.loc(self.path), &format!("<{kind}>"), what);
                 o.child("Radiance").map(Node::mark_subtree_used);
             }
-            self.unsupported(o, "Texture", "textures are");
+            self.unsupported(o, "Texture", "textures in the pre-2022 form are");
+            let textures = self.object_textures(o, &name)?;
             let (material, shape) = if kind == "MeshInstance" {
                 let base_id =
                     o.attr("baseMeshId").ok_or_else(|| self.err(o, format!("{name}: missing attribute baseMeshId")))?;
@@ -63,7 +65,8 @@ impl Reader<'_> {
                 };
                 let has_material = o.child("Material").is_some();
                 let material = if has_material { self.material_of(o, &name)? } else { 0 };
-                pending.push(Pending { object: self.desc.objects.len(), base_id, reset, has_material });
+                let has_textures = o.child("Textures").is_some();
+                pending.push(Pending { object: self.desc.objects.len(), base_id, reset, has_material, has_textures });
                 (material, ShapeDesc::Instance { base: 0 })
             } else {
                 let material = self.material_of(o, &name)?;
@@ -86,7 +89,8 @@ impl Reader<'_> {
                     ids.insert(id.clone(), base);
                 }
             }
-            self.desc.objects.push(ObjectDesc { name, material, shape, transform, motion, loc: o.loc(self.path) });
+            let loc = o.loc(self.path);
+            self.desc.objects.push(ObjectDesc { name, material, shape, transform, motion, textures, loc });
         }
         self.resolve_instances(&pending, &ids)
     }
@@ -131,9 +135,9 @@ impl Reader<'_> {
                     Base::Mesh(m) => (m, m),
                     Base::Instance(b) => (pending[b].object, mesh_of[b].unwrap_or_default()),
                 };
-                let (base_transform, base_material) = {
+                let (base_transform, base_material, base_textures) = {
                     let b = &self.desc.objects[base_object];
-                    (b.transform, b.material)
+                    (b.transform, b.material, b.textures.clone())
                 };
                 let inst = &mut self.desc.objects[p.object];
                 inst.shape = ShapeDesc::Instance { base: mesh };
@@ -143,6 +147,9 @@ impl Reader<'_> {
                 }
                 if !p.has_material {
                     inst.material = base_material;
+                }
+                if !p.has_textures {
+                    inst.textures = base_textures;
                 }
                 mesh_of[i] = Some(mesh);
             }
@@ -175,7 +182,7 @@ impl Reader<'_> {
                     let msg = format!("<Indices>: expected 3 vertex ids, found {}", idx.len());
                     return Err(self.err(ind, msg));
                 }
-                let mesh = self.compact(ind, name, &idx, 0)?;
+                let mesh = self.compact(ind, name, &idx, 0, 0)?;
                 ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false }
             }
             "Plane" => ShapeDesc::Plane { point: self.vertex_ref(o, "Point", name)?, normal: self.unit(o, "Normal")? },
@@ -198,10 +205,10 @@ impl Reader<'_> {
             let msg = format!("<Faces>: unknown type '{}' (expected triangle)", t.trimmed());
             return Err(Error::input(t.loc(p), msg));
         }
-        if let Some(a) = faces.attr("textureOffset") {
-            let label = "attribute textureOffset of <Faces>";
-            self.notes.feature(a.loc(p), label, "textures not supported; ignored");
-        }
+        let tex_offset = match faces.attr("textureOffset") {
+            Some(a) => a.int(p)?,
+            None => 0,
+        };
         if let Some(ply) = faces.attr("plyFile") {
             if !faces.trimmed().is_empty() {
                 let msg = format!("{name}: inline faces ignored, the mesh comes from plyFile");
@@ -218,23 +225,28 @@ impl Reader<'_> {
             let msg = format!("<Faces>: expected vertex id triples, found {} ids", idx.len());
             return Err(self.err(faces, msg));
         }
-        Ok(MeshSource::Inline(Arc::new(self.compact(faces, name, &idx, offset)?)))
+        Ok(MeshSource::Inline(Arc::new(self.compact(faces, name, &idx, offset, tex_offset)?)))
     }
 
-    /// The triangles `idx` (1-based ids, plus `offset`) as a mesh of only the vertices they use.
-    fn compact(&self, at: &Node, name: &str, idx: &[i64], offset: i64) -> Result<TriangleMesh> {
-        let mut remap: HashMap<usize, u32> = HashMap::new();
+    /// The triangles `idx` (1-based ids, plus `offset`) as a mesh of only the vertices they use; with
+    /// `TexCoordData`, each corner's (u, v) is the pair of its id plus `tex_offset`.
+    fn compact(&self, at: &Node, name: &str, idx: &[i64], offset: i64, tex_offset: i64) -> Result<TriangleMesh> {
+        let mut remap: HashMap<(usize, usize), u32> = HashMap::new();
         let mut mesh = TriangleMesh::default();
+        let mut uvs = Vec::new();
         let mut corners = Vec::with_capacity(idx.len());
         for &raw in idx {
             let v = self.vertex_index(at, name, "vertex index", raw, offset)?;
+            let t = if self.uvs.is_empty() { 0 } else { self.uv_index(at, name, raw, tex_offset)? };
             let next = mesh.positions.len() as u32;
-            let i = *remap.entry(v).or_insert_with(|| {
+            let i = *remap.entry((v, t)).or_insert_with(|| {
                 mesh.positions.push(self.vertices[v]);
+                uvs.extend(self.uvs.get(t).copied());
                 next
             });
             corners.push(i);
         }
+        mesh.uvs = (!self.uvs.is_empty()).then_some(uvs);
         mesh.indices = corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         Ok(mesh)
     }
@@ -251,6 +263,19 @@ impl Reader<'_> {
             _ => format!("{raw} + vertexOffset {offset} = {id}"),
         };
         let msg = format!("{name}: {what} {shown} out of range (VertexData has {n} vertices, numbered from 1)");
+        Err(self.err(at, msg))
+    }
+
+    /// A 1-based texture coordinate id (plus `offset`) as a 0-based index into `TexCoordData`.
+    fn uv_index(&self, at: &Node, name: &str, raw: i64, offset: i64) -> Result<usize> {
+        let id = raw.saturating_add(offset);
+        let n = self.uvs.len();
+        if id >= 1 && (id as u64) <= n as u64 {
+            return Ok(id as usize - 1);
+        }
+        let shown = if offset == 0 { raw.to_string() } else { format!("{raw} + textureOffset {offset} = {id}") };
+        let msg =
+            format!("{name}: texture coordinate {shown} out of range (TexCoordData has {n} pairs, numbered from 1)");
         Err(self.err(at, msg))
     }
 

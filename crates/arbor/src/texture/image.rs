@@ -1,0 +1,130 @@
+//! Image textures: texels kept as the file stores them (8-bit images as `u8`, EXR and HDR as `f32`),
+//! sampled at (u, v) with u to the right and v down from the top-left corner, repeating outside [0, 1];
+//! nearest or bilinear (pbrt-v4 §10.4.3), with edge texels repeated for the bilinear neighbours.
+
+use std::path::Path;
+
+use crate::math::{Color, Vec2};
+use crate::Result;
+
+/// Texel storage.
+#[derive(Debug)]
+enum Texels {
+    /// 8-bit RGB, row-major from the top.
+    U8(Vec<u8>),
+    /// Float RGB, row-major from the top.
+    F32(Vec<f32>),
+}
+
+/// An image loaded for texturing; shared by every map that samples it.
+#[derive(Debug)]
+pub struct TexImage {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    texels: Texels,
+}
+
+impl TexImage {
+    /// An 8-bit RGB image, row-major from the top.
+    ///
+    /// # Panics
+    /// When `bytes` is not `3 * width * height` long or the image is empty.
+    pub fn from_rgb8(width: u32, height: u32, bytes: Vec<u8>) -> TexImage {
+        assert!(width > 0 && height > 0 && bytes.len() == 3 * width as usize * height as usize);
+        TexImage { width, height, texels: Texels::U8(bytes) }
+    }
+
+    /// Reads PNG or JPEG as 8-bit texels, EXR and HDR as floats.
+    pub fn load(path: &Path) -> Result<TexImage> {
+        let hdr = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if matches!(hdr.as_deref(), Some("exr" | "hdr")) {
+            let film = crate::image_io::read_image(path)?;
+            let texels = film.pixels.iter().flat_map(|c| c.to_array()).collect();
+            return Ok(TexImage { width: film.width, height: film.height, texels: Texels::F32(texels) });
+        }
+        let (w, h, bytes) = crate::image_io::read_rgb8(path)?;
+        if w == 0 || h == 0 {
+            let msg = "image has no texels".to_string();
+            return Err(crate::Error::input(crate::Location::file(path), msg));
+        }
+        Ok(TexImage::from_rgb8(w, h, bytes))
+    }
+
+    /// Whether texels are 8-bit.
+    pub fn is_8bit(&self) -> bool {
+        matches!(self.texels, Texels::U8(_))
+    }
+
+    /// The texel at column `x`, row `y` (clamped to the image), as stored (0-255 for 8-bit images).
+    #[inline]
+    pub fn texel(&self, x: i64, y: i64) -> Color {
+        let x = x.clamp(0, self.width as i64 - 1) as usize;
+        let y = y.clamp(0, self.height as i64 - 1) as usize;
+        let i = 3 * (y * self.width as usize + x);
+        match &self.texels {
+            Texels::U8(b) => Color::new(b[i] as f32, b[i + 1] as f32, b[i + 2] as f32),
+            Texels::F32(f) => Color::new(f[i], f[i + 1], f[i + 2]),
+        }
+    }
+
+    /// The texel nearest to `uv` (the one the point falls in).
+    #[inline]
+    pub fn nearest(&self, uv: Vec2) -> Color {
+        let (x, y) = self.texel_coords(uv);
+        self.texel(x.floor() as i64, y.floor() as i64)
+    }
+
+    /// The four texels around `uv` weighted by distance, texel corners at integer coordinates.
+    #[inline]
+    pub fn bilinear(&self, uv: Vec2) -> Color {
+        let (x, y) = self.texel_coords(uv);
+        let (px, py) = (x.floor(), y.floor());
+        let (dx, dy) = (x - px, y - py);
+        let (px, py) = (px as i64, py as i64);
+        self.texel(px, py) * ((1.0 - dx) * (1.0 - dy))
+            + self.texel(px + 1, py) * (dx * (1.0 - dy))
+            + self.texel(px, py + 1) * ((1.0 - dx) * dy)
+            + self.texel(px + 1, py + 1) * (dx * dy)
+    }
+
+    /// Continuous texel coordinates of `uv`, repeated into the image.
+    #[inline]
+    fn texel_coords(&self, uv: Vec2) -> (f32, f32) {
+        let (u, v) = (uv.x - uv.x.floor(), uv.y - uv.y.floor());
+        (u * self.width as f32, v * self.height as f32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 2x2: red, green / blue, white.
+    fn img() -> TexImage {
+        TexImage::from_rgb8(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+    }
+
+    #[test]
+    fn image_nearest_picks_the_texel_the_point_falls_in() {
+        let i = img();
+        assert_eq!(i.nearest(Vec2::new(0.25, 0.25)), Color::new(255.0, 0.0, 0.0));
+        assert_eq!(i.nearest(Vec2::new(0.75, 0.25)), Color::new(0.0, 255.0, 0.0));
+        assert_eq!(i.nearest(Vec2::new(0.25, 0.75)), Color::new(0.0, 0.0, 255.0));
+        // Repeats outside [0, 1].
+        assert_eq!(i.nearest(Vec2::new(1.75, -0.25)), Color::splat(255.0));
+    }
+
+    #[test]
+    fn image_bilinear_weights_by_distance_and_repeats_edges() {
+        let i = img();
+        // Halfway between the four texel corners (1, 1), (2, 1), (1, 2), (2, 2): only (1, 1) is inside;
+        // the others repeat the edge texels.
+        assert_eq!(i.bilinear(Vec2::new(0.5, 0.5)), Color::splat(255.0));
+        // x = 0.5, y = 0: half red, half green.
+        assert!(i.bilinear(Vec2::new(0.25, 0.0)).abs_diff_eq(Color::new(127.5, 127.5, 0.0), 1e-4));
+        // x = 0.5, y = 0.5: the mean of all four.
+        assert!(i.bilinear(Vec2::new(0.25, 0.25)).abs_diff_eq(Color::new(127.5, 127.5, 127.5), 1e-4));
+    }
+}

@@ -1,0 +1,180 @@
+//! Textures at render time (CENG 795 2022 hw4): image textures ([`image`]), Perlin noise ([`perlin`])
+//! and a 3D checkerboard ([`checker`]), each with the decal mode that says what its value replaces;
+//! [`apply`] applies an object's textures to its shading terms and normal, in one place. The build step
+//! makes them from the description; nothing here knows the scene file.
+
+mod checker;
+mod image;
+pub mod perlin;
+
+use std::sync::Arc;
+
+use crate::math::{Color, Vec2, Vec3};
+
+pub use checker::Checkerboard;
+pub use image::TexImage;
+
+/// What a texture's value replaces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Decal {
+    /// k_d.
+    ReplaceKd,
+    /// k_d, averaged with the material's.
+    BlendKd,
+    /// k_s.
+    ReplaceKs,
+    /// The shaded colour.
+    ReplaceAll,
+    /// The background of camera rays that miss.
+    ReplaceBackground,
+    /// The shading normal (tangent space).
+    ReplaceNormal,
+    /// The shading normal, through a height field.
+    BumpNormal,
+}
+
+/// Where a texture's value comes from.
+#[derive(Debug)]
+pub enum Source {
+    /// An image, sampled at (u, v); texels are divided by `normalizer`.
+    Image {
+        /// The image (shared).
+        image: Arc<TexImage>,
+        /// Bilinear (else nearest).
+        bilinear: bool,
+        /// Texel divisor.
+        normalizer: f32,
+    },
+    /// Perlin noise at the object-space point times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
+    Perlin {
+        /// `|n|` (else linear).
+        absval: bool,
+        /// Frequency.
+        scale: f32,
+    },
+    /// A checkerboard at the object-space point.
+    Checker(Checkerboard),
+}
+
+/// A texture map ready for shading.
+#[derive(Debug)]
+pub struct Texture {
+    /// Its values.
+    pub source: Source,
+    /// What they replace.
+    pub decal: Decal,
+    /// Multiplies the height field of a bump map.
+    pub bump_factor: f32,
+}
+
+/// Where a surface is sampled, in object space: texture coordinates, the point, the shading normal and
+/// the derivatives of the point along u and v.
+#[derive(Debug, Clone, Copy)]
+pub struct TexPoint {
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Object-space point (where the object is at time 0).
+    pub p: Vec3,
+    /// Unit object-space shading normal.
+    pub n: Vec3,
+    /// ∂p/∂u.
+    pub dpdu: Vec3,
+    /// ∂p/∂v.
+    pub dpdv: Vec3,
+}
+
+impl Texture {
+    /// The texture's value at `at`, normalised (images divided by their normalizer).
+    pub fn eval(&self, at: &TexPoint) -> Color {
+        match &self.source {
+            Source::Image { image, bilinear, normalizer } => {
+                let c = if *bilinear { image.bilinear(at.uv) } else { image.nearest(at.uv) };
+                c / *normalizer
+            }
+            Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.p * *scale), *absval)),
+            Source::Checker(c) => c.eval(at.p),
+        }
+    }
+
+    /// The bump-mapped object-space normal at `at`: the surface displaced along its normal by the
+    /// texture's height times the bump factor (Blinn 1978), the normal of the displaced surface.
+    fn bumped(&self, at: &TexPoint) -> Vec3 {
+        let n = at.n;
+        let k = self.bump_factor;
+        match &self.source {
+            Source::Image { image, bilinear, .. } => {
+                // The height is the texel's mean as stored, and its slope the change from one texel to
+                // the next, so that a bump factor means the same on any image size.
+                let height = |uv: Vec2| {
+                    let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
+                    (c.x + c.y + c.z) / 3.0
+                };
+                let (du, dv) = (1.0 / image.width as f32, 1.0 / image.height as f32);
+                let h = height(at.uv);
+                let dhdu = height(at.uv + Vec2::new(du, 0.0)) - h;
+                let dhdv = height(at.uv + Vec2::new(0.0, dv)) - h;
+                let pu = at.dpdu + k * dhdu * n;
+                let pv = at.dpdv + k * dhdv * n;
+                let m = pu.cross(pv).normalize_or(n);
+                if m.dot(n) < 0.0 {
+                    -m
+                } else {
+                    m
+                }
+            }
+            Source::Perlin { absval, scale } => {
+                let q = at.p * *scale;
+                let nv = perlin::noise(q);
+                let slope = if *absval { nv.signum() } else { 0.5 };
+                let g = perlin::gradient(q) * (slope * *scale * k);
+                (n - (g - g.dot(n) * n)).normalize_or(n)
+            }
+            Source::Checker(_) => n,
+        }
+    }
+}
+
+/// Noise in [-1, 1] to [0, 1].
+fn convert(n: f32, absval: bool) -> f32 {
+    if absval {
+        n.abs()
+    } else {
+        (n + 1.0) * 0.5
+    }
+}
+
+/// Blinn-Phong terms and shading normal after an object's textures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shaded {
+    /// k_a.
+    pub ambient: Color,
+    /// k_d.
+    pub diffuse: Color,
+    /// k_s.
+    pub specular: Color,
+    /// Object-space shading normal (unit).
+    pub n: Vec3,
+    /// The colour that replaces all shading (`replace_all`), if any.
+    pub replace_all: Option<Color>,
+}
+
+/// Applies `textures` in order to the terms `base` at `at`.
+pub fn apply<'a>(textures: impl IntoIterator<Item = &'a Texture>, mut base: Shaded, at: &TexPoint) -> Shaded {
+    for t in textures {
+        match t.decal {
+            Decal::ReplaceKd => base.diffuse = t.eval(at),
+            Decal::BlendKd => base.diffuse = (base.diffuse + t.eval(at)) * 0.5,
+            Decal::ReplaceKs => base.specular = t.eval(at),
+            Decal::ReplaceAll => base.replace_all = Some(t.eval(at)),
+            Decal::ReplaceBackground => {}
+            Decal::ReplaceNormal => {
+                let c = t.eval(at) * 2.0 - Color::ONE;
+                let tu = at.dpdu.normalize_or_zero();
+                let tv = at.dpdv.normalize_or_zero();
+                base.n = (tu * c.x + tv * c.y + at.n * c.z).normalize_or(at.n);
+            }
+            Decal::BumpNormal => base.n = t.bumped(at),
+        }
+    }
+    base
+}
