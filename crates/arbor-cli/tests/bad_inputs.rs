@@ -185,6 +185,16 @@ fn catalogue() -> Vec<Row> {
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
     cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
+    // Textures: missing or undecodable images, unknown modes, types and ids, coordinates out of range,
+    // divisors and frequencies that are not positive.
+    render("texture_coord_out_of_range.xml", 3, "error: texture_coord_out_of_range.xml:38:66: Mesh 1: texture coordinate 3 + textureOffset 1 = 4 out of range (TexCoordData has 3 pairs, numbered from 1)\n"),
+    render("texture_image_missing.xml", 3, "error: texture_image_missing.xml:24:17: cannot read texture image 'nothere.png': No such file or directory (os error 2)\n"),
+    render("texture_image_unreadable.xml", 3, "error: texture_image_unreadable.xml:24:17: cannot read texture image 'not_an_image.png': cannot decode image: Format error decoding Png: Invalid PNG signature.\n"),
+    render("texture_noise_scale_negative.xml", 3, "error: texture_noise_scale_negative.xml:24:75: TextureMap 1: NoiseScale -2 must be positive\n"),
+    render("texture_normalizer_zero.xml", 3, "error: texture_normalizer_zero.xml:25:94: TextureMap 1: Normalizer 0 must be positive\n"),
+    render("texture_unknown_decal.xml", 3, "error: texture_unknown_decal.xml:25:61: TextureMap 1: unknown DecalMode 'replace_everything'\n"),
+    render("texture_unknown_id.xml", 3, "error: texture_unknown_id.xml:33:46: Sphere 1: no <TextureMap id=\"7\"> in <Textures>\n"),
+    render("texture_unknown_type.xml", 3, "error: texture_unknown_type.xml:25:28: TextureMap 1: unknown type 'marble'\n"),
     // Mesh files given directly: bench takes them, render and info say so.
     cmd(&["render", "huge_count.ply", "-o", "OUT"], 3, "error: huge_count.ply: this is a mesh file, not a scene (.xml or .json); `arbor bench huge_count.ply` takes meshes\n"),
     cmd(&["info", "inf.obj"], 3, "error: inf.obj: this is a mesh file, not a scene (.xml or .json); `arbor bench inf.obj` takes meshes\n"),

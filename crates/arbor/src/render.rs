@@ -190,7 +190,7 @@ fn trace(
     let start = Instant::now();
     let cam = &scene.cameras[camera];
     let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
-    let integrator = Whitted::new(scene, cull);
+    let integrator = Whitted::new(scene, cull).with_camera(cam);
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
     let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
     let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(cam.num_samples).max(1) };

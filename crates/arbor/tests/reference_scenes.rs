@@ -1,7 +1,7 @@
 //! The course scenes against their official reference images.
 //!
-//! Every scene of the 2024 XML set, the 2025 JSON sets (hw1, hw3), the 2022 hw2 set and the NYU bunny is
-//! rendered and compared with its reference. A scene of one sample per pixel passes when at most 0.5% of
+//! Every scene of the 2024 XML set, the 2025 JSON sets (hw1, hw3), the 2022 hw2 and hw4 sets and the NYU
+//! bunny is rendered and compared with its reference. A scene of one sample per pixel passes when at most 0.5% of
 //! its pixels differ by more than 8 levels in any channel. A scene of more samples has a reference made
 //! of the official renderer's own random numbers, which no other sampler reproduces pixel for pixel: it
 //! passes when at most 2% of its 8x8-pixel block means differ by more than 8 levels in any channel. By
@@ -11,7 +11,9 @@
 //! The 2024 set has references without back-face culling (`outputs_nobfc/`), compared with an unculled
 //! render, and with it (`outputs/`), compared with a culled render wherever the two references differ.
 //! The 2025 references are the culled ones; the 2022 hw2 ones unculled (`grass/README.txt` says so, and
-//! the other scenes look the same either way). A scene whose mesh files are missing is skipped, by name.
+//! the other scenes look the same either way); the 2022 hw4 ones unculled too, except the scenes of
+//! `HW4_EXCLUDED`, left out by name with what was measured. A scene whose mesh files are missing is skipped,
+//! by name.
 //!
 //! Each test writes its results as a Markdown table to `$CARGO_TARGET_TMPDIR` (collected into
 //! `docs/reference-results.md`).
@@ -197,6 +199,50 @@ fn reference_ceng795_2022_hw2() {
     let Some(dir) = common::scenes_dir() else { return };
     let (cases, skipped) = hw2_2022(&dir);
     check(run("CENG 795 2022 hw2", cases, skipped, Some(FEW_SAMPLES)).1);
+}
+
+/// 2022 hw4 scenes left out of [`reference_ceng795_2022_hw4`], each with what was measured (unculled; one
+/// sample per pixel unless said) and why no reading of the assignment text matches it.
+const HW4_EXCLUDED: &[(&str, &str)] = &[
+    ("cube_perlin.xml", PERLIN),
+    ("cube_perlin_bump.xml", PERLIN),
+    ("sphere_perlin.xml", PERLIN),
+    ("sphere_perlin_bump.xml", PERLIN),
+    ("sphere_perlin_scale.xml", PERLIN),
+    ("ellipsoids_texture.xml", PERLIN),
+    ("wood_box_all.xml", MESH_BUMP),
+    ("bump_mapping_transformed.xml", MESH_BUMP),
+    ("galactica_static.xml", MESH_BUMP),
+    ("galactica_dynamic.xml", MESH_BUMP),
+];
+/// Why the Perlin scenes are left out.
+const PERLIN: &str = "Perlin noise: the text gives no gradient table, permutation or fade function, and the \
+    references' patterns are not Perlin's reference noise (2002); measured: cube_perlin 31.6%, cube_perlin_bump \
+    35.5%, sphere_perlin 23.0%, sphere_perlin_bump 23.0%, sphere_perlin_scale 22.6% of pixels off; \
+    ellipsoids_texture 5.4%, all of it on its two Perlin ellipsoids (its image-textured ones match)";
+/// Why the scenes with bump maps on meshes are left out.
+const MESH_BUMP: &str = "bump maps on triangle meshes: the height-field slope read as the change of the texel \
+    mean per texel (the reading that matches the bump-mapped spheres, sphere_nobump_bump 0.07% and \
+    sphere_nobump_justbump 0.03% of pixels off) leaves fine-grained differences on meshes; measured: \
+    wood_box_all 19.7% (wood_box, the same scene without the bump map, 0.000%), bump_mapping_transformed \
+    2.5%, galactica_static 2.4% of pixels off; galactica_dynamic 16 of 100 samples, 8x8 blocks";
+
+/// The 2022 hw4 scenes (textures), unculled, without [`HW4_EXCLUDED`].
+fn hw4_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw4"), "xml", &[("outputs", false)]);
+    assert!(cases.len() >= 21, "only {} cases found", cases.len());
+    for (scene, why) in HW4_EXCLUDED {
+        println!("EXCLUDED {scene}: {why}");
+    }
+    let excluded = |c: &Case| HW4_EXCLUDED.iter().any(|(name, _)| c.scene.file_name().is_some_and(|f| f == *name));
+    (cases.into_iter().filter(|c| !excluded(c)).collect(), skipped)
+}
+
+#[test]
+fn reference_ceng795_2022_hw4() {
+    let Some(dir) = common::scenes_dir() else { return };
+    let (cases, skipped) = hw4_2022(&dir);
+    check(run("CENG 795 2022 hw4", cases, skipped, Some(FEW_SAMPLES)).1);
 }
 
 #[test]

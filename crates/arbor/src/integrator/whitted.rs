@@ -17,8 +17,9 @@
 
 use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
+use crate::camera::Camera;
 use crate::material::{beer, blinn_phong, perturb, Material};
-use crate::math::{Color, Ray};
+use crate::math::{Color, Ray, Vec2};
 use crate::sampler::Rng;
 use crate::scene::Scene;
 
@@ -26,12 +27,18 @@ use crate::scene::Scene;
 pub struct Whitted<'a> {
     scene: &'a Scene,
     cull_backfaces: bool,
+    camera: Option<&'a Camera>,
 }
 
 impl<'a> Whitted<'a> {
     /// An integrator over `scene`; `cull_backfaces` applies to camera rays only.
     pub fn new(scene: &'a Scene, cull_backfaces: bool) -> Self {
-        Whitted { scene, cull_backfaces }
+        Whitted { scene, cull_backfaces, camera: None }
+    }
+
+    /// The integrator for the camera rays of `camera`, which a background texture spans.
+    pub fn with_camera(self, camera: &'a Camera) -> Self {
+        Whitted { camera: Some(camera), ..self }
     }
 
     /// Radiance (in the scene's units) along a camera ray.
@@ -156,6 +163,15 @@ impl<'a> Whitted<'a> {
             return env.eval(ray.dir) / scene.radiance_scale;
         }
         if depth == 0 {
+            if let (Some(t), Some(cam)) = (scene.background_texture, self.camera) {
+                // The texture covers the image plane, pixel (i, j) at (i / width, j / height): an image
+                // of the film's size shows one texel per pixel.
+                if let Some(px) = cam.project(ray.origin + ray.dir) {
+                    let (i, j) = (px.x.floor() / cam.width as f64, px.y.floor() / cam.height as f64);
+                    let uv = Vec2::new(i as f32, j as f32);
+                    return scene.textures[t].eval_uv(uv) / scene.radiance_scale;
+                }
+            }
             scene.background
         } else {
             Color::ZERO

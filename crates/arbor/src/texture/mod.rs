@@ -96,6 +96,13 @@ impl Texture {
         }
     }
 
+    /// The value at texture coordinates `uv` alone (a background): procedural textures see the point
+    /// (u, v, 0).
+    pub fn eval_uv(&self, uv: Vec2) -> Color {
+        let at = TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y };
+        self.eval(&at)
+    }
+
     /// The bump-mapped object-space normal at `at`: the surface displaced along its normal by the
     /// texture's height times the bump factor (Blinn 1978), the normal of the displaced surface.
     fn bumped(&self, at: &TexPoint) -> Vec3 {
@@ -177,4 +184,59 @@ pub fn apply<'a>(textures: impl IntoIterator<Item = &'a Texture>, mut base: Shad
         }
     }
     base
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image_texture(decal: Decal, bump_factor: f32, image: TexImage) -> Texture {
+        Texture {
+            source: Source::Image { image: Arc::new(image), bilinear: false, normalizer: 255.0 },
+            decal,
+            bump_factor,
+        }
+    }
+
+    /// The plane z = 0 with (u, v) = (x, y).
+    fn plane_point(uv: Vec2) -> TexPoint {
+        TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y }
+    }
+
+    #[test]
+    fn bump_map_of_a_ramp_gives_the_ramps_normal() {
+        // Grey texels rising by 10 per texel along x, constant along y.
+        let bytes = (0..8u8).flat_map(|_| (0..8u8).flat_map(|x| [10 * x; 3])).collect();
+        let t = image_texture(Decal::BumpNormal, 0.5, TexImage::from_rgb8(8, 8, bytes));
+        let base =
+            Shaded { ambient: Color::ZERO, diffuse: Color::ONE, specular: Color::ZERO, n: Vec3::Z, replace_all: None };
+        let out = apply([&t], base, &plane_point(Vec2::new(0.3, 0.5)));
+        // Height k·h rises by 0.5 · 10 per unit of u: the surface z = 5u has normal (-5, 0, 1)/|.|.
+        assert!(out.n.abs_diff_eq(Vec3::new(-5.0, 0.0, 1.0).normalize(), 1e-5), "{}", out.n);
+        assert_eq!(out.diffuse, Color::ONE);
+    }
+
+    #[test]
+    fn decal_modes_replace_what_they_name() {
+        let img = || TexImage::from_rgb8(1, 1, vec![255, 0, 51]);
+        let base = Shaded {
+            ambient: Color::ONE,
+            diffuse: Color::splat(0.5),
+            specular: Color::ONE,
+            n: Vec3::Z,
+            replace_all: None,
+        };
+        let at = plane_point(Vec2::splat(0.5));
+        let kd = apply([&image_texture(Decal::ReplaceKd, 1.0, img())], base, &at);
+        assert_eq!(kd.diffuse, Color::new(1.0, 0.0, 0.2));
+        let blend = apply([&image_texture(Decal::BlendKd, 1.0, img())], base, &at);
+        assert!(blend.diffuse.abs_diff_eq(Color::new(0.75, 0.25, 0.35), 1e-6));
+        let ks = apply([&image_texture(Decal::ReplaceKs, 1.0, img())], base, &at);
+        assert_eq!((ks.specular, ks.diffuse), (Color::new(1.0, 0.0, 0.2), base.diffuse));
+        let all = apply([&image_texture(Decal::ReplaceAll, 1.0, img())], base, &at);
+        assert_eq!(all.replace_all, Some(Color::new(1.0, 0.0, 0.2)));
+        // A tangent-space normal of (1, 0.5, 0.6) after mapping [0, 1] to [-1, 1]: (1, 0, 0.2).
+        let normal = apply([&image_texture(Decal::ReplaceNormal, 1.0, img())], base, &at);
+        assert!(normal.n.abs_diff_eq(Vec3::new(1.0, -1.0, -0.6).normalize(), 1e-6), "{}", normal.n);
+    }
 }

@@ -8,7 +8,7 @@ use super::Reader;
 use crate::math::{Color, Vec2};
 use crate::scene::desc::{DecalMode, ImageDesc, Interpolation, NoiseConversion, TextureDesc, TextureSource};
 use crate::scene::readers::tree::Node;
-use crate::Result;
+use crate::{Error, Result};
 
 impl Reader<'_> {
     /// Every image and texture map of a `Textures` element.
@@ -105,7 +105,7 @@ impl Reader<'_> {
                 let (black, white) = (color(self, "BlackColor", 0.0)?, color(self, "WhiteColor", 1.0)?);
                 TextureSource::Checkerboard { scale, offset, black, white }
             }
-            other => return Err(self.err(map, format!("{name}: unknown type '{other}'"))),
+            other => return Err(Error::input(kind.loc(p), format!("{name}: unknown type '{other}'"))),
         };
         Ok(TextureDesc { id: id.to_string(), source, decal, bump_factor, loc: map.loc(p) })
     }
@@ -142,5 +142,89 @@ impl Reader<'_> {
         }
         self.uvs = f.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::super::{read, Form};
+    use crate::scene::desc::{DecalMode, Interpolation, MeshSource, SceneDesc, ShapeDesc, TextureSource};
+    use crate::scene::readers::xml;
+    use crate::Result;
+
+    const MATERIAL: &str = "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                            <DiffuseReflectance>1 1 1</DiffuseReflectance></Material></Materials>";
+
+    fn read_xml(body: &str) -> Result<SceneDesc> {
+        let path = Path::new("t.xml");
+        read(&xml::parse(&format!("<Scene>{MATERIAL}{body}</Scene>"), path)?, path, Form::Xml)
+    }
+
+    fn textures(maps: &str) -> String {
+        format!("<Textures><Images><Image id=\"1\">a.png</Image></Images>{maps}</Textures>")
+    }
+
+    #[test]
+    fn metu_texture_maps_are_read_with_their_defaults() {
+        let body = textures(
+            "<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId><DecalMode>blend_kd</DecalMode></TextureMap>\
+             <TextureMap id=\"2\" type=\"checkerboard\"><DecalMode>replace_kd</DecalMode><Scale>2</Scale>\
+             </TextureMap>",
+        )
+            + "<VertexData>0 0 0 1 0 0 0 1 0</VertexData><TexCoordData>0 0 1 0 0 1 1 1</TexCoordData><Objects>\
+             <Mesh id=\"1\"><Material>1</Material><Textures>2 1</Textures>\
+             <Faces textureOffset=\"1\">1 2 3</Faces></Mesh></Objects>";
+        let d = read_xml(&body).unwrap();
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+        assert_eq!(d.images.len(), 1);
+        assert_eq!(d.textures[0].decal, DecalMode::BlendKd);
+        let TextureSource::Image { image: 0, interpolation, normalizer, .. } = d.textures[0].source else {
+            panic!("{:?}", d.textures[0].source)
+        };
+        assert_eq!((interpolation, normalizer), (Interpolation::Nearest, 255.0));
+        assert!(matches!(d.textures[1].source, TextureSource::Checkerboard { scale: 2.0, offset: 0.0, .. }));
+        assert_eq!(d.objects[0].textures, [1, 0]);
+        let ShapeDesc::Mesh { source: MeshSource::Inline(m), .. } = &d.objects[0].shape else { panic!() };
+        // Corner ids 1 2 3 plus textureOffset 1 take pairs 2 3 4.
+        let uvs = m.uvs.as_ref().unwrap();
+        assert_eq!(uvs.iter().map(|v| v.to_array()).collect::<Vec<_>>(), [[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]);
+    }
+
+    #[test]
+    fn metu_texture_errors_are_located() {
+        let map = |inner: &str| {
+            textures(&format!("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>{inner}</TextureMap>"))
+        };
+        let err = |body: String| read_xml(&body).unwrap_err().to_string();
+        assert_eq!(err(map("<DecalMode>paint</DecalMode>")), "t.xml:1:257: TextureMap 1: unknown DecalMode 'paint'");
+        assert_eq!(
+            err(map("<DecalMode>replace_kd</DecalMode><Normalizer>-1</Normalizer>")),
+            "t.xml:1:290: TextureMap 1: Normalizer -1 must be positive"
+        );
+        assert_eq!(
+            err(textures(
+                "<TextureMap id=\"1\" type=\"perlin\"><DecalMode>replace_kd</DecalMode>\
+                          <NoiseScale>0</NoiseScale></TextureMap>"
+            )),
+            "t.xml:1:271: TextureMap 1: NoiseScale 0 must be positive"
+        );
+        assert_eq!(
+            err(textures("<TextureMap id=\"1\" type=\"wood\"><DecalMode>replace_kd</DecalMode></TextureMap>")),
+            "t.xml:1:224: TextureMap 1: unknown type 'wood'"
+        );
+        assert_eq!(
+            err(map("<DecalMode>replace_kd</DecalMode>")
+                + "<VertexData>0 0 0</VertexData><Objects><Sphere id=\"1\"><Material>1</Material>\
+                   <Textures>2</Textures><Center>1</Center><Radius>1</Radius></Sphere></Objects>"),
+            "t.xml:1:390: Sphere 1: no <TextureMap id=\"2\"> in <Textures>"
+        );
+        assert_eq!(
+            err("<VertexData>0 0 0 1 0 0 0 1 0</VertexData><TexCoordData>0 0 1 0</TexCoordData><Objects>\
+                 <Mesh id=\"1\"><Material>1</Material><Faces>1 2 3</Faces></Mesh></Objects>"
+                .to_string()),
+            "t.xml:1:273: Mesh 1: texture coordinate 3 out of range (TexCoordData has 2 pairs, numbered from 1)"
+        );
     }
 }
