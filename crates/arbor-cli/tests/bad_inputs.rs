@@ -297,8 +297,8 @@ fn bad_inputs_give_located_errors_and_never_panic() {
     );
 }
 
-/// Every scene of the catalogue has its row, and every mesh file is named by some scene or row, so that
-/// no file lies there untested.
+/// Every scene of the catalogue has its row, and every mesh file and texture image is named by some scene
+/// or row, so that no file lies there untested.
 #[test]
 fn bad_inputs_catalogue_is_complete() {
     let rows = catalogue();
@@ -308,7 +308,7 @@ fn bad_inputs_catalogue_is_complete() {
     for entry in std::fs::read_dir(catalogue_dir()).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         match Path::new(&name).extension().and_then(|e| e.to_str()) {
-            Some("ply" | "obj" | "off") => meshes.push(name),
+            Some("ply" | "obj" | "off" | "png") => meshes.push(name),
             _ => {
                 assert!(named(&name), "no row for {name}");
                 scenes.push_str(&String::from_utf8_lossy(&std::fs::read(catalogue_dir().join(&name)).unwrap()));
@@ -316,6 +316,7 @@ fn bad_inputs_catalogue_is_complete() {
         }
     }
     for m in meshes {
-        assert!(scenes.contains(&format!("\"{m}\"")) || named(&m), "no scene or row uses {m}");
+        let used = scenes.contains(&format!("\"{m}\"")) || scenes.contains(&format!(">{m}<"));
+        assert!(used || named(&m), "no scene or row uses {m}");
     }
 }
