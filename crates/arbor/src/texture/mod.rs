@@ -1,5 +1,5 @@
-//! Textures at render time (CENG 795 2022 hw4): image textures ([`image`]), Perlin noise ([`perlin`])
-//! and a 3D checkerboard ([`checker`]), each with the decal mode that says what its value replaces;
+//! Textures at render time (CENG 795 2022 hw4): image textures ([`TexImage`]), Perlin noise ([`perlin`])
+//! and a 3D checkerboard ([`Checkerboard`]), each with the decal mode that says what its value replaces;
 //! [`apply`] applies an object's textures to its shading terms and normal, in one place. The build step
 //! makes them from the description; nothing here knows the scene file.
 
