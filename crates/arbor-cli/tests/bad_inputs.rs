@@ -193,7 +193,7 @@ fn catalogue() -> Vec<Row> {
     render("texture_noise_scale_negative.xml", 3, "error: texture_noise_scale_negative.xml:24:75: TextureMap 1: NoiseScale -2 must be positive\n"),
     render("texture_normalizer_zero.xml", 3, "error: texture_normalizer_zero.xml:25:94: TextureMap 1: Normalizer 0 must be positive\n"),
     render("texture_unknown_decal.xml", 3, "error: texture_unknown_decal.xml:25:61: TextureMap 1: unknown DecalMode 'replace_everything'\n"),
-    render("texture_unknown_id.xml", 3, "error: texture_unknown_id.xml:33:46: Sphere 1: no <TextureMap id=\"7\"> in <Textures>\n"),
+    render("texture_unknown_id.xml", 3, "error: texture_unknown_id.xml:33:46: Sphere 1: no texture map with id '7'\n"),
     render("texture_unknown_type.xml", 3, "error: texture_unknown_type.xml:25:28: TextureMap 1: unknown type 'marble'\n"),
     // Mesh files given directly: bench takes them, render and info say so.
     cmd(&["render", "huge_count.ply", "-o", "OUT"], 3, "error: huge_count.ply: this is a mesh file, not a scene (.xml or .json); `arbor bench huge_count.ply` takes meshes\n"),

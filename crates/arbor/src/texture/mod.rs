@@ -44,6 +44,8 @@ pub enum Source {
         bilinear: bool,
         /// Texel divisor.
         normalizer: f32,
+        /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
+        clamp: bool,
     },
     /// Perlin noise at the object-space point times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
     Perlin {
@@ -87,8 +89,9 @@ impl Texture {
     /// The texture's value at `at`, normalised (images divided by their normalizer).
     pub fn eval(&self, at: &TexPoint) -> Color {
         match &self.source {
-            Source::Image { image, bilinear, normalizer } => {
-                let c = if *bilinear { image.bilinear(at.uv) } else { image.nearest(at.uv) };
+            Source::Image { image, bilinear, normalizer, clamp } => {
+                let uv = if *clamp { at.uv.clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON)) } else { at.uv };
+                let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
                 c / *normalizer
             }
             Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.p * *scale), *absval)),
@@ -192,7 +195,7 @@ mod tests {
 
     fn image_texture(decal: Decal, bump_factor: f32, image: TexImage) -> Texture {
         Texture {
-            source: Source::Image { image: Arc::new(image), bilinear: false, normalizer: 255.0 },
+            source: Source::Image { image: Arc::new(image), bilinear: false, normalizer: 255.0, clamp: false },
             decal,
             bump_factor,
         }

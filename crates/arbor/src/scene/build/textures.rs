@@ -49,10 +49,11 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
 
 fn build_texture(t: &TextureDesc, images: &HashMap<usize, Arc<TexImage>>) -> Texture {
     let source = match t.source {
-        TextureSource::Image { image, interpolation, normalizer, .. } => Source::Image {
+        TextureSource::Image { image, interpolation, normalizer, clamp, .. } => Source::Image {
             image: images[&image].clone(),
             bilinear: interpolation == Interpolation::Bilinear,
             normalizer,
+            clamp,
         },
         TextureSource::Perlin { conversion, scale } => {
             Source::Perlin { absval: conversion == NoiseConversion::AbsVal, scale }

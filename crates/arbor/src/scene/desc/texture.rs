@@ -66,6 +66,8 @@ pub enum TextureSource {
         normalizer: f32,
         /// Whether 8-bit texels are sRGB-encoded and linearised before use.
         degamma: bool,
+        /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
+        clamp: bool,
     },
     /// Perlin noise at the object-space point times `scale`.
     Perlin {

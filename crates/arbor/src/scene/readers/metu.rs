@@ -133,8 +133,9 @@ struct Reader<'a> {
     materials: HashMap<String, usize>,
     /// `Textures/Images/Image` by id: the file name as written, for lights that name an image.
     images: HashMap<String, String>,
-    /// `TextureMap` ids, as indices into the description's textures.
-    texture_ids: HashMap<String, usize>,
+    /// `TextureMap` (or pre-2022 `Texture`) ids, as indices into the description's textures: one map, or
+    /// two for a pre-2022 texture that is also a bump map.
+    texture_ids: HashMap<String, Vec<usize>>,
     /// `TexCoordData`, numbered from 1 like the vertices.
     uvs: Vec<Vec2>,
     /// A pre-2020 file: untyped materials take their kind from the elements present.
@@ -232,7 +233,9 @@ impl Reader<'_> {
         if let Some(t) = self.one(root, "Textures") {
             self.textures(t)?;
         }
-        self.unsupported(root, "BackgroundTexture", "background textures are");
+        if let Some(n) = self.one(root, "BackgroundTexture") {
+            self.background_texture(n);
+        }
         self.unsupported(root, "BRDFs", "BRDF models are");
         Ok(())
     }
@@ -621,15 +624,15 @@ mod tests {
     fn metu_unsupported_feature_is_one_warning_with_a_count() {
         let body = format!(
             "{MATERIAL}<VertexData>0 0 0</VertexData><Objects>\
-             <Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <Texture>1</Texture></Sphere>\
-             <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <Texture>1</Texture></Sphere></Objects>"
+             <LightSphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <Radiance>1 1 1</Radiance></LightSphere>\
+             <LightSphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <Radiance>1 1 1</Radiance></LightSphere></Objects>"
         );
         let d = read_xml(&body).unwrap();
         assert_eq!(
             d.warnings,
-            ["t.xml:1:263: <Texture>: textures in the pre-2022 form are not supported; ignored (2 occurrences)"]
+            ["t.xml:1:190: <LightSphere>: emission not supported; rendered as an ordinary object (2 occurrences)"]
         );
     }
 

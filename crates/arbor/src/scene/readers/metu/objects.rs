@@ -54,7 +54,6 @@ impl Reader<'_> {
                 self.notes.feature(o.loc(self.path), &format!("<{kind}>"), what);
                 o.child("Radiance").map(Node::mark_subtree_used);
             }
-            self.unsupported(o, "Texture", "textures in the pre-2022 form are");
             let textures = self.object_textures(o, &name)?;
             let (material, shape) = if kind == "MeshInstance" {
                 let base_id =
@@ -65,7 +64,7 @@ impl Reader<'_> {
                 };
                 let has_material = o.child("Material").is_some();
                 let material = if has_material { self.material_of(o, &name)? } else { 0 };
-                let has_textures = o.child("Textures").is_some();
+                let has_textures = o.child("Textures").is_some() || o.child("Texture").is_some();
                 pending.push(Pending { object: self.desc.objects.len(), base_id, reset, has_material, has_textures });
                 (material, ShapeDesc::Instance { base: 0 })
             } else {

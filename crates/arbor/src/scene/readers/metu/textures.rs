@@ -1,6 +1,12 @@
 //! The `Textures` of a METU scene (CENG 795 2022 hw4): `Images` (file names by id) and `TextureMap`s
 //! of type `image`, `perlin` or `checkerboard`, each with its `DecalMode`; objects name their maps in
 //! their own `Textures` element. `TexCoordData` holds the (u, v) pairs of inline meshes.
+//!
+//! The pre-2022 form (2019 hw4) is read into the same description: a `Texture` names its file in
+//! `ImageName` (or `perlin`, `checkerboard`), scales procedures by `ScalingFactor` (Perlin `Appearance`
+//! `patch` is the linear conversion, `vein` the absolute value), and with `bumpmap="true"` is also a
+//! bump map (`bumpmapMultiplier`); objects name it in `Texture` elements, and `BackgroundTexture` names
+//! the background's file.
 
 use std::collections::HashMap;
 
@@ -30,28 +36,101 @@ impl Reader<'_> {
             let id = map.attr("id").ok_or_else(|| self.err(map, "<TextureMap>: missing attribute id"))?;
             let id = id.trimmed().to_string();
             let texture = self.texture_map(map, &id, &images)?;
-            self.texture_ids.insert(id, self.desc.textures.len());
+            self.texture_ids.insert(id, vec![self.desc.textures.len()]);
             self.desc.textures.push(texture);
         }
-        self.unsupported(t, "Texture", "textures in the pre-2022 form are");
+        for tex in t.all("Texture") {
+            tex.mark_used();
+            self.legacy_texture(tex)?;
+        }
         Ok(())
+    }
+
+    /// A pre-2022 `Texture`: one map for its decal mode, and a second one when it is also a bump map.
+    fn legacy_texture(&mut self, tex: &Node) -> Result<()> {
+        let p = self.path;
+        let id = tex.attr("id").ok_or_else(|| self.err(tex, "<Texture>: missing attribute id"))?.trimmed().to_string();
+        let name = format!("Texture {id}");
+        let file = self.req(tex, "ImageName")?;
+        let decal = self.decal_mode(tex, &name)?;
+        let scale = match self.one(tex, "ScalingFactor") {
+            Some(n) => n.float(p)?,
+            None => 1.0,
+        };
+        let appearance = self.one(tex, "Appearance").map(|n| (n, n.trimmed()));
+        if matches!(file.trimmed(), "perlin" | "checkerboard") {
+            // Procedural values are already in [0, 1]: the files' Normalizer of 1 leaves them so.
+            self.positive(tex, "Normalizer", &name)?;
+        }
+        let source = match file.trimmed() {
+            "perlin" => {
+                let conversion = match appearance {
+                    None | Some((_, "patch")) => NoiseConversion::Linear,
+                    Some((_, "vein")) => NoiseConversion::AbsVal,
+                    Some((n, other)) => return Err(self.err(n, format!("{name}: unknown Appearance '{other}'"))),
+                };
+                if scale <= 0.0 {
+                    return Err(self.err(tex, format!("{name}: ScalingFactor {scale} must be positive")));
+                }
+                TextureSource::Perlin { conversion, scale }
+            }
+            "checkerboard" => self.checkerboard(tex, scale)?,
+            path => {
+                let (interpolation, normalizer) = self.image_sampling(tex, &name)?;
+                let clamp = match appearance {
+                    None | Some((_, "repeat")) => false,
+                    Some((_, "clamp")) => true,
+                    Some((n, other)) => return Err(self.err(n, format!("{name}: unknown Appearance '{other}'"))),
+                };
+                let image = self.desc.images.len();
+                self.desc.images.push(ImageDesc { path: self.dir.join(path), loc: file.loc(p) });
+                TextureSource::Image { image, interpolation, normalizer, degamma: false, clamp }
+            }
+        };
+        let mut maps = vec![self.desc.textures.len()];
+        let loc = tex.loc(p);
+        let bump = match tex.attr("bumpmap") {
+            Some(a) => a.boolean(p)?,
+            None => false,
+        };
+        let bump_factor = match tex.attr("bumpmapMultiplier") {
+            Some(a) => a.trimmed().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                crate::Error::input(a.loc(p), format!("{name}: bumpmapMultiplier '{}' is not a number", a.trimmed()))
+            })?,
+            None => 1.0,
+        };
+        let desc = TextureDesc { id: id.clone(), source: source.clone(), decal, bump_factor, loc: loc.clone() };
+        self.desc.textures.push(desc);
+        if bump {
+            maps.push(self.desc.textures.len());
+            let decal = DecalMode::BumpNormal;
+            self.desc.textures.push(TextureDesc { id: id.clone(), source, decal, bump_factor, loc });
+        }
+        self.texture_ids.insert(id, maps);
+        Ok(())
+    }
+
+    /// The pre-2022 `BackgroundTexture`: an image spanning the image plane.
+    pub(super) fn background_texture(&mut self, n: &Node) {
+        let image = self.desc.images.len();
+        self.desc.images.push(ImageDesc { path: self.dir.join(n.trimmed()), loc: n.loc(self.path) });
+        let source = TextureSource::Image {
+            image,
+            interpolation: Interpolation::Nearest,
+            normalizer: 255.0,
+            degamma: false,
+            clamp: true,
+        };
+        let decal = DecalMode::ReplaceBackground;
+        let t = TextureDesc { id: "background".into(), source, decal, bump_factor: 1.0, loc: n.loc(self.path) };
+        self.desc.textures.push(t);
     }
 
     fn texture_map(&mut self, map: &Node, id: &str, images: &HashMap<String, usize>) -> Result<TextureDesc> {
         let p = self.path;
         let name = format!("TextureMap {id}");
         let kind = map.attr("type").ok_or_else(|| self.err(map, format!("{name}: missing attribute type")))?;
-        let d = self.req(map, "DecalMode")?;
-        let decal = match d.trimmed() {
-            "replace_kd" => DecalMode::ReplaceKd,
-            "blend_kd" => DecalMode::BlendKd,
-            "replace_ks" => DecalMode::ReplaceKs,
-            "replace_all" => DecalMode::ReplaceAll,
-            "replace_background" => DecalMode::ReplaceBackground,
-            "replace_normal" => DecalMode::ReplaceNormal,
-            "bump_normal" => DecalMode::BumpNormal,
-            other => return Err(self.err(d, format!("{name}: unknown DecalMode '{other}'"))),
-        };
+        let decal = self.decal_mode(map, &name)?;
         let bump_factor = match self.one(map, "BumpFactor") {
             Some(n) => n.float(p)?,
             None => 1.0,
@@ -62,21 +141,12 @@ impl Reader<'_> {
                 let image = *images.get(i.trimmed()).ok_or_else(|| {
                     self.err(i, format!("{name}: no <Image id=\"{}\"> in <Textures><Images>", i.trimmed()))
                 })?;
-                let interpolation = match self.one(map, "Interpolation").map(|n| (n, n.trimmed())) {
-                    None | Some((_, "nearest")) => Interpolation::Nearest,
-                    Some((_, "bilinear")) => Interpolation::Bilinear,
-                    Some((n, other)) => {
-                        let msg = format!("{name}: unknown Interpolation '{other}'; bilinear used");
-                        self.notes.plain(n.loc(p), msg);
-                        Interpolation::Bilinear
-                    }
-                };
-                let normalizer = self.positive(map, "Normalizer", &name)?.unwrap_or(255.0);
+                let (interpolation, normalizer) = self.image_sampling(map, &name)?;
                 let degamma = match map.attr("degamma") {
                     Some(a) => a.boolean(p)?,
                     None => false,
                 };
-                TextureSource::Image { image, interpolation, normalizer, degamma }
+                TextureSource::Image { image, interpolation, normalizer, degamma, clamp: false }
             }
             "perlin" => {
                 let conversion = match self.one(map, "NoiseConversion").map(|n| (n, n.trimmed())) {
@@ -88,26 +158,60 @@ impl Reader<'_> {
                 TextureSource::Perlin { conversion, scale }
             }
             "checkerboard" => {
-                let color = |r: &mut Self, n: &str, c: f32| -> Result<Color> {
-                    Ok(match r.one(map, n) {
-                        Some(v) => v.vec3(p)?,
-                        None => Color::splat(c),
-                    })
-                };
                 let scale = match self.one(map, "Scale") {
                     Some(n) => n.float(p)?,
                     None => 1.0,
                 };
-                let offset = match self.one(map, "Offset") {
-                    Some(n) => n.float(p)?,
-                    None => 0.0,
-                };
-                let (black, white) = (color(self, "BlackColor", 0.0)?, color(self, "WhiteColor", 1.0)?);
-                TextureSource::Checkerboard { scale, offset, black, white }
+                self.checkerboard(map, scale)?
             }
             other => return Err(Error::input(kind.loc(p), format!("{name}: unknown type '{other}'"))),
         };
         Ok(TextureDesc { id: id.to_string(), source, decal, bump_factor, loc: map.loc(p) })
+    }
+
+    fn decal_mode(&mut self, map: &Node, name: &str) -> Result<DecalMode> {
+        let d = self.req(map, "DecalMode")?;
+        Ok(match d.trimmed() {
+            "replace_kd" => DecalMode::ReplaceKd,
+            "blend_kd" => DecalMode::BlendKd,
+            "replace_ks" => DecalMode::ReplaceKs,
+            "replace_all" => DecalMode::ReplaceAll,
+            "replace_background" => DecalMode::ReplaceBackground,
+            "replace_normal" => DecalMode::ReplaceNormal,
+            "bump_normal" => DecalMode::BumpNormal,
+            other => return Err(self.err(d, format!("{name}: unknown DecalMode '{other}'"))),
+        })
+    }
+
+    /// `Interpolation` (nearest when absent) and `Normalizer` (255 when absent) of an image texture.
+    fn image_sampling(&mut self, map: &Node, name: &str) -> Result<(Interpolation, f32)> {
+        let interpolation = match self.one(map, "Interpolation").map(|n| (n, n.trimmed())) {
+            None | Some((_, "nearest")) => Interpolation::Nearest,
+            Some((_, "bilinear")) => Interpolation::Bilinear,
+            Some((n, other)) => {
+                let msg = format!("{name}: unknown Interpolation '{other}'; bilinear used");
+                self.notes.plain(n.loc(self.path), msg);
+                Interpolation::Bilinear
+            }
+        };
+        Ok((interpolation, self.positive(map, "Normalizer", name)?.unwrap_or(255.0)))
+    }
+
+    /// A checkerboard's `Offset`, `BlackColor` and `WhiteColor`, with its `scale`.
+    fn checkerboard(&mut self, map: &Node, scale: f32) -> Result<TextureSource> {
+        let p = self.path;
+        let mut color = |n: &str, c: f32| -> Result<Color> {
+            Ok(match self.one(map, n) {
+                Some(v) => v.vec3(p)?,
+                None => Color::splat(c),
+            })
+        };
+        let (black, white) = (color("BlackColor", 0.0)?, color("WhiteColor", 1.0)?);
+        let offset = match self.one(map, "Offset") {
+            Some(n) => n.float(p)?,
+            None => 0.0,
+        };
+        Ok(TextureSource::Checkerboard { scale, offset, black, white })
     }
 
     /// The child `child` of `map` as a positive number, if present.
@@ -120,16 +224,19 @@ impl Reader<'_> {
         Ok(Some(v))
     }
 
-    /// The maps an object names in its `Textures` element, as indices.
+    /// The maps an object names in its `Textures` element (or pre-2022 `Texture` elements), as indices.
     pub(super) fn object_textures(&mut self, o: &Node, name: &str) -> Result<Vec<usize>> {
-        let Some(t) = self.one(o, "Textures") else { return Ok(Vec::new()) };
         let mut out = Vec::new();
-        for id in t.trimmed().split_whitespace() {
-            let i = *self
-                .texture_ids
-                .get(id)
-                .ok_or_else(|| self.err(t, format!("{name}: no <TextureMap id=\"{id}\"> in <Textures>")))?;
-            out.push(i);
+        let lists = self.one(o, "Textures").into_iter().chain(o.all("Texture"));
+        for t in lists.collect::<Vec<_>>() {
+            t.mark_used();
+            for id in t.trimmed().split_whitespace() {
+                let maps = self
+                    .texture_ids
+                    .get(id)
+                    .ok_or_else(|| self.err(t, format!("{name}: no texture map with id '{id}'")))?;
+                out.extend_from_slice(maps);
+            }
         }
         Ok(out)
     }
@@ -193,6 +300,32 @@ mod tests {
     }
 
     #[test]
+    fn metu_pre_2022_textures_become_maps_and_bump_maps() {
+        let body = "<BackgroundTexture>sky.jpg</BackgroundTexture><Textures>\
+                    <Texture id=\"1\" bumpmap=\"true\" bumpmapMultiplier=\"30\"><ImageName>a.jpg</ImageName>\
+                    <Interpolation>bilinear</Interpolation><DecalMode>replace_kd</DecalMode>\
+                    <Appearance>clamp</Appearance></Texture>\
+                    <Texture id=\"2\"><ImageName>perlin</ImageName><ScalingFactor>3</ScalingFactor>\
+                    <Appearance>vein</Appearance><DecalMode>blend_kd</DecalMode><Normalizer>1</Normalizer></Texture>\
+                    </Textures><VertexData>0 0 0</VertexData><Objects><Sphere id=\"1\"><Material>1</Material>\
+                    <Texture>1</Texture><Texture>2</Texture><Center>1</Center><Radius>1</Radius></Sphere></Objects>";
+        let d = read_xml(body).unwrap();
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+        let decals: Vec<DecalMode> = d.textures.iter().map(|t| t.decal).collect();
+        assert_eq!(
+            decals,
+            [DecalMode::ReplaceKd, DecalMode::BumpNormal, DecalMode::BlendKd, DecalMode::ReplaceBackground]
+        );
+        assert_eq!(d.textures[1].bump_factor, 30.0);
+        assert!(matches!(d.textures[0].source, TextureSource::Image { clamp: true, image: 0, .. }));
+        assert!(matches!(
+            d.textures[2].source,
+            TextureSource::Perlin { conversion: crate::scene::desc::NoiseConversion::AbsVal, scale: 3.0 }
+        ));
+        assert_eq!(d.objects[0].textures, [0, 1, 2]);
+    }
+
+    #[test]
     fn metu_texture_errors_are_located() {
         let map = |inner: &str| {
             textures(&format!("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>{inner}</TextureMap>"))
@@ -218,7 +351,7 @@ mod tests {
             err(map("<DecalMode>replace_kd</DecalMode>")
                 + "<VertexData>0 0 0</VertexData><Objects><Sphere id=\"1\"><Material>1</Material>\
                    <Textures>2</Textures><Center>1</Center><Radius>1</Radius></Sphere></Objects>"),
-            "t.xml:1:390: Sphere 1: no <TextureMap id=\"2\"> in <Textures>"
+            "t.xml:1:390: Sphere 1: no texture map with id '2'"
         );
         assert_eq!(
             err("<VertexData>0 0 0 1 0 0 0 1 0</VertexData><TexCoordData>0 0 1 0</TexCoordData><Objects>\
