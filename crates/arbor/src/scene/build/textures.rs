@@ -73,3 +73,52 @@ fn build_texture(t: &TextureDesc, images: &HashMap<usize, Arc<TexImage>>) -> Tex
     };
     Texture { source, decal, bump_factor: t.bump_factor }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::desc::ImageDesc;
+    use crate::Location;
+
+    fn map(image: usize, interpolation: Interpolation) -> TextureDesc {
+        let source = TextureSource::Image { image, interpolation, normalizer: 255.0, degamma: false, clamp: false };
+        TextureDesc {
+            id: "1".into(),
+            source,
+            decal: DecalMode::ReplaceKd,
+            bump_factor: 1.0,
+            loc: Location::file("t.xml"),
+        }
+    }
+
+    #[test]
+    fn build_textures_loads_a_shared_image_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        image::RgbImage::from_raw(1, 1, vec![10, 20, 30]).unwrap().save(&path).unwrap();
+        let mut desc = SceneDesc::new("t.xml");
+        // Two ids of the same file, three maps over them.
+        for _ in 0..2 {
+            desc.images.push(ImageDesc { path: path.clone(), loc: Location::file("t.xml") });
+        }
+        desc.textures =
+            vec![map(0, Interpolation::Nearest), map(0, Interpolation::Bilinear), map(1, Interpolation::Nearest)];
+        let t = build_textures(&desc).unwrap();
+        let image = |t: &Texture| match &t.source {
+            Source::Image { image, .. } => image.clone(),
+            _ => unreachable!(),
+        };
+        assert!(Arc::ptr_eq(&image(&t[0]), &image(&t[1])) && Arc::ptr_eq(&image(&t[0]), &image(&t[2])));
+        assert!(image(&t[0]).is_8bit());
+    }
+
+    #[test]
+    fn build_textures_locates_a_missing_image_at_its_element() {
+        let mut desc = SceneDesc::new("t.xml");
+        let loc = Location { line: Some(3), col: Some(7), ..Location::file("t.xml") };
+        desc.images.push(ImageDesc { path: "/nonexistent/a.png".into(), loc });
+        desc.textures = vec![map(0, Interpolation::Nearest)];
+        let e = build_textures(&desc).unwrap_err().to_string();
+        assert!(e.starts_with("t.xml:3:7: cannot read texture image '/nonexistent/a.png': "), "{e}");
+    }
+}
