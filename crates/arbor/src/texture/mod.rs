@@ -112,11 +112,12 @@ impl Texture {
         let n = at.n;
         let k = self.bump_factor;
         match &self.source {
-            Source::Image { image, bilinear, .. } => {
-                // The height is the texel's mean as stored, and its slope the change from one texel to
-                // the next, so that a bump factor means the same on any image size.
+            Source::Image { image, .. } => {
+                // The height is a texel's mean as stored, and its slope the difference between the texel
+                // at the point and the next one, whatever the map's interpolation: so a bump factor means
+                // the same at any image size, and the slope is constant across a texel.
                 let height = |uv: Vec2| {
-                    let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
+                    let c = image.nearest(uv);
                     (c.x + c.y + c.z) / 3.0
                 };
                 let (du, dv) = (1.0 / image.width as f32, 1.0 / image.height as f32);
