@@ -10,13 +10,15 @@
 //!   square with a warning, so that the jittered grid stays square; `ApertureSize` 0 is a pinhole;
 //! - untyped (pre-2020) materials: a non-zero `Transparency` means glass, else a non-zero
 //!   `MirrorReflectance` means a mirror. Only legacy files follow this rule: XML files in which no
-//!   material has a `type`. Files that type their materials, and the 2025 JSON form always, keep
+//!   material has a `type` and that use no 2022 texture element (`TextureMap`, `Images`; the 2022
+//!   `galactica_static.png` shows no reflection from its untyped mirror). Files that type their
+//!   materials, and the 2025 JSON form always, keep
 //!   untyped materials plain Blinn-Phong, as the official renderers do (the 2025 `raven.png` reference
 //!   shows no reflection from its untyped `MirrorReflectance` at depth 6);
 //! - an absent `MaxRecursionDepth` is 0 in XML (the 2024 official parser) and 6 in the 2025 JSON form,
 //!   whose `bunny_with_plane.png` reference shows its mirror plane with no depth given;
 //! - duplicated single-valued elements: the last one wins, with a warning;
-//! - what Arbor does not render (textures, motion blur, BRDFs, tone mapping...) is one warning per
+//! - what Arbor does not render (BRDFs, tone mapping, emission...) is one warning per
 //!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
 
 use std::collections::HashMap;
@@ -46,7 +48,7 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         desc: SceneDesc { max_depth: if form == Form::Json { 6 } else { 0 }, ..SceneDesc::new(path) },
-        legacy: form == Form::Xml && !typed_materials(root),
+        legacy: form == Form::Xml && !typed_materials(root) && !texture_maps(root),
         notes: Notes::default(),
         vertices: Vec::new(),
         transforms: HashMap::new(),
@@ -150,6 +152,13 @@ fn typed_materials(root: &Node) -> bool {
         .filter(|c| c.name == "Materials")
         .flat_map(|m| m.children.iter().filter(|c| c.name == "Material"))
         .any(|m| m.attrs.iter().any(|a| a.name == "type"))
+}
+
+/// True when the scene's `Textures` use the 2022 form (`TextureMap`, `Images`). Looked up without marking
+/// anything as read.
+fn texture_maps(root: &Node) -> bool {
+    let textures = root.children.iter().filter(|c| c.name == "Textures").flat_map(|t| &t.children);
+    textures.into_iter().any(|c| c.name == "TextureMap" || c.name == "Images")
 }
 
 /// The `Image` elements of `Textures/Images` by id (the last one of an id wins), looked up without

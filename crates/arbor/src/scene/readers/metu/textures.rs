@@ -326,6 +326,22 @@ mod tests {
     }
 
     #[test]
+    fn metu_texture_maps_mark_a_file_as_post_2020_for_untyped_mirrors() {
+        let mirror = "<Materials><Material id=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                      <DiffuseReflectance>1 1 1</DiffuseReflectance>\
+                      <MirrorReflectance>1 1 1</MirrorReflectance></Material></Materials>";
+        let kind = |textures: &str| {
+            let path = Path::new("t.xml");
+            let body = format!("<Scene><MaxRecursionDepth>6</MaxRecursionDepth>{mirror}{textures}</Scene>");
+            read(&xml::parse(&body, path).unwrap(), path, Form::Xml).unwrap().materials[0].kind.clone()
+        };
+        assert!(matches!(kind(""), crate::scene::desc::MaterialKind::Mirror { .. }));
+        let maps = textures("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>\
+                             <DecalMode>replace_kd</DecalMode></TextureMap>");
+        assert_eq!(kind(&maps), crate::scene::desc::MaterialKind::BlinnPhong);
+    }
+
+    #[test]
     fn metu_texture_errors_are_located() {
         let map = |inner: &str| {
             textures(&format!("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>{inner}</TextureMap>"))
