@@ -336,8 +336,10 @@ mod tests {
             read(&xml::parse(&body, path).unwrap(), path, Form::Xml).unwrap().materials[0].kind.clone()
         };
         assert!(matches!(kind(""), crate::scene::desc::MaterialKind::Mirror { .. }));
-        let maps = textures("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>\
-                             <DecalMode>replace_kd</DecalMode></TextureMap>");
+        let maps = textures(
+            "<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>\
+                             <DecalMode>replace_kd</DecalMode></TextureMap>",
+        );
         assert_eq!(kind(&maps), crate::scene::desc::MaterialKind::BlinnPhong);
     }
 
