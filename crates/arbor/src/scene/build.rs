@@ -25,7 +25,7 @@ use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
-use crate::math::Aabb;
+use crate::math::{Aabb, Vec3};
 use crate::{Error, Location, Result};
 
 impl Scene {
@@ -175,7 +175,11 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             ShapeDesc::Plane { point, normal } => {
                 let point = object.transform.point(*point);
                 let normal = object.transform.normal(*normal).normalize();
-                planes.push(ScenePlane { plane: Plane { point, normal }, object: index as u32, motion: object.motion });
+                planes.push(ScenePlane {
+                    plane: Plane { point, normal },
+                    object: index as u32,
+                    motion: moving(object),
+                });
                 continue;
             }
             ShapeDesc::Instance { .. } => unreachable!("resolve_instance never returns an instance"),
@@ -193,7 +197,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
         let object = SceneObject {
             transform: if matches!(shape, Shape::Sphere(_)) { None } else { transform },
             shape,
-            motion: object.motion,
+            motion: moving(object),
             bounds,
             object: index as u32,
             first_prim,
@@ -207,6 +211,11 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     counts.objects = objects.len();
     let top = spec.build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
+}
+
+/// An object's motion over the shutter interval, `None` when it stands still.
+fn moving(object: &ObjectDesc) -> Option<Vec3> {
+    (object.motion != Vec3::ZERO).then_some(object.motion)
 }
 
 /// A mesh ready for rendering: smooth meshes get vertex normals (from the file, or averaged from the

@@ -97,7 +97,7 @@ impl Scene {
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
                 // Where a moving object is at the ray's time; shapes below are placed at time 0.
-                let shift = o.motion * ray.time;
+                let shift = o.motion.map_or(Vec3::ZERO, |m| m * ray.time);
                 let (ng, ns) = match &o.shape {
                     Shape::Mesh(m) => {
                         if bound {
@@ -137,7 +137,7 @@ impl Scene {
             None => {
                 let ScenePlane { plane, object, motion } = g.planes[hit.prim as usize - g.objects.objects.len()];
                 if bound {
-                    let shift = motion * ray.time;
+                    let shift = motion.map_or(Vec3::ZERO, |m| m * ray.time);
                     (p, p_error) = plane_point(p - shift, plane.point, plane.normal);
                     p += shift;
                 }
