@@ -180,7 +180,7 @@ fn catalogue() -> Vec<Row> {
     cmd(&["bench", "sphere:100", "--accel-param", "depth=4"], 2, "error: --accel-param 'depth=4' is not KIND:KEY=VALUE\n"),
     // Merge: a part that is no partial EXR, or missing.
     cmd(&["merge", "truncated.xml", "-o", "OUT/merged.png"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
-    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg\n"),
+    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, hdr, jpg, jpeg\n"),
     cmd(&["merge", "no_such_part.exr", "-o", "OUT/merged.png"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),

@@ -98,6 +98,7 @@ pub fn build_camera(desc: &CameraDesc) -> Camera {
     camera.id = desc.id.clone();
     camera.image_name = desc.image_name.clone();
     camera.num_samples = desc.num_samples;
+    camera.tonemap = desc.tonemap;
     camera
 }
 
@@ -296,6 +297,7 @@ mod tests {
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,
+            tonemap: None,
             loc: Location::file("x.xml"),
         }
     }

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
+use crate::tonemap::Tonemap;
 use crate::Location;
 
 /// A whole scene as described by its file.
@@ -150,6 +151,8 @@ pub struct CameraDesc {
     pub transform: Transform,
     /// Depth of field, when the file asks for it with a non-zero aperture.
     pub lens: Option<Lens>,
+    /// Tone mapping of the image (`Tonemap`); none: radiance written as it is.
+    pub tonemap: Option<Tonemap>,
     /// Where the camera is defined.
     pub loc: Location,
 }
