@@ -66,6 +66,12 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             LightDesc::Directional { direction, radiance } => {
                 say!("light      directional along {direction}, radiance {radiance}")
             }
+            LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
+                say!(
+                    "light      spot at {position} along {direction}, intensity {intensity}, coverage {coverage_deg}°, \
+                     fall-off {falloff_deg}°"
+                )
+            }
         }
     }
     for m in &desc.materials {

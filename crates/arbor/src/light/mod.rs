@@ -9,6 +9,7 @@ mod area;
 mod directional;
 pub mod environment;
 mod point;
+mod spot;
 
 use std::fmt;
 
@@ -17,6 +18,7 @@ use crate::math::{Color, Vec2, Vec3};
 pub use area::AreaLight;
 pub use directional::DirectionalLight;
 pub use point::PointLight;
+pub use spot::SpotLight;
 
 /// Light arriving at a point from one light (or one point on an area light).
 #[derive(Debug, Clone, Copy, PartialEq)]

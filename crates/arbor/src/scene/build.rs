@@ -23,7 +23,7 @@ use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
-use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
+use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SpotLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
 use crate::math::Aabb;
 use crate::{Error, Location, Result};
@@ -131,6 +131,13 @@ fn build_light(desc: &LightDesc) -> Box<dyn Light> {
             Box::new(AreaLight { position, normal, size, radiance })
         }
         LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+        LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
+            match SpotLight::new(position, direction, intensity, coverage_deg, falloff_deg) {
+                Some(spot) => Box::new(spot),
+                // The readers refuse a zero direction; a description made otherwise gets a dark light.
+                None => Box::new(PointLight { position, intensity: crate::math::Color::ZERO }),
+            }
+        }
     }
 }
 

@@ -185,6 +185,20 @@ pub enum LightDesc {
         /// Irradiance on a surface facing it.
         radiance: Color,
     },
+    /// A point light emitting in a cone around `direction` (full angles in degrees,
+    /// `0 < falloff_deg <= coverage_deg <= 360`).
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Axis of the cone (unit).
+        direction: Vec3,
+        /// Intensity inside the fall-off cone.
+        intensity: Color,
+        /// Full angle of the cone outside which no light leaves.
+        coverage_deg: f32,
+        /// Full angle of the cone inside which the light is a point light.
+        falloff_deg: f32,
+    },
 }
 
 /// How a material reflects beyond its Blinn-Phong terms.

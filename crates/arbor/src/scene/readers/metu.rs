@@ -296,6 +296,7 @@ impl Reader<'_> {
                     intensity: self.req(n, "Intensity")?.vec3(p)?,
                 },
                 "AreaLight" => self.area_light(n)?,
+                "SpotLight" => self.spot_light(n)?,
                 "DirectionalLight" => LightDesc::Directional {
                     direction: self.unit(n, "Direction")?,
                     radiance: self.req(n, "Radiance")?.vec3(p)?,
@@ -333,7 +334,6 @@ impl Reader<'_> {
             n.attr("id");
             self.desc.lights.push(light);
         }
-        self.unsupported(l, "SpotLight", "spot lights are");
         Ok(())
     }
 
@@ -354,6 +354,26 @@ impl Reader<'_> {
         }
         let radiance = self.req(n, "Radiance")?.vec3(p)?;
         Ok(LightDesc::Area { position, normal, size, radiance })
+    }
+
+    /// A `SpotLight`: full cone angles in degrees with `0 < FalloffAngle <= CoverageAngle <= 360` (the
+    /// fall-off cone lies inside the coverage cone; a cone's half angle is at most 180°).
+    fn spot_light(&mut self, n: &Node) -> Result<LightDesc> {
+        let p = self.path;
+        let position = self.req(n, "Position")?.vec3(p)?;
+        let direction = self.unit(n, "Direction")?;
+        let intensity = self.req(n, "Intensity")?.vec3(p)?;
+        let (cov_node, fall_node) = (self.req(n, "CoverageAngle")?, self.req(n, "FalloffAngle")?);
+        let (coverage_deg, falloff_deg) = (cov_node.float(p)?, fall_node.float(p)?);
+        if !(coverage_deg > 0.0 && coverage_deg <= 360.0) {
+            let msg = format!("<CoverageAngle>: {coverage_deg} degrees must be in (0, 360]");
+            return Err(self.err(cov_node, msg));
+        }
+        if !(falloff_deg > 0.0 && falloff_deg <= coverage_deg) {
+            let msg = format!("<FalloffAngle>: {falloff_deg} degrees must be in (0, CoverageAngle {coverage_deg}]");
+            return Err(self.err(fall_node, msg));
+        }
+        Ok(LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg })
     }
 
     /// The child `name` of `n` as a unit vector.
