@@ -365,12 +365,13 @@ impl Reader<'_> {
         let intensity = self.req(n, "Intensity")?.vec3(p)?;
         let (cov_node, fall_node) = (self.req(n, "CoverageAngle")?, self.req(n, "FalloffAngle")?);
         let (coverage_deg, falloff_deg) = (cov_node.float(p)?, fall_node.float(p)?);
+        let name = || format!("SpotLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));
         if !(coverage_deg > 0.0 && coverage_deg <= 360.0) {
-            let msg = format!("<CoverageAngle>: {coverage_deg} degrees must be in (0, 360]");
+            let msg = format!("{}: CoverageAngle {coverage_deg} must be in (0, 360] degrees", name());
             return Err(self.err(cov_node, msg));
         }
         if !(falloff_deg > 0.0 && falloff_deg <= coverage_deg) {
-            let msg = format!("<FalloffAngle>: {falloff_deg} degrees must be in (0, CoverageAngle {coverage_deg}]");
+            let msg = format!("{}: FalloffAngle {falloff_deg} must be in (0, CoverageAngle {coverage_deg}]", name());
             return Err(self.err(fall_node, msg));
         }
         Ok(LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg })
