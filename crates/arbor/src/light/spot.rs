@@ -51,7 +51,7 @@ impl SpotLight {
 }
 
 impl Light for SpotLight {
-    fn sample(&self, p: Vec3, _u: Vec2) -> Option<LightSample> {
+    fn sample(&self, p: Vec3, _n: Vec3, _u: Vec2) -> Option<LightSample> {
         let to_light = self.position - p;
         let d2 = to_light.length_squared();
         // Negated so that a NaN distance (a NaN point) gives no light, as a zero one does.
@@ -77,11 +77,11 @@ mod tests {
 
     #[test]
     fn spot_light_is_a_point_light_inside_the_falloff_cone() {
-        let s = spot().sample(Vec3::ZERO, Vec2::ZERO).unwrap();
+        let s = spot().sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO).unwrap();
         assert_eq!((s.wi, s.dist, s.irradiance), (Vec3::Y, 2.0, Color::splat(25.0)));
         // 20° off the axis, still inside the 30° half fall-off angle.
         let x = 2.0 * 20f32.to_radians().tan();
-        let s = spot().sample(Vec3::new(x, 0.0, 0.0), Vec2::ZERO).unwrap();
+        let s = spot().sample(Vec3::new(x, 0.0, 0.0), Vec3::Y, Vec2::ZERO).unwrap();
         assert!((s.irradiance.x - 100.0 / (4.0 + x * x)).abs() < 1e-4);
     }
 
@@ -93,8 +93,8 @@ mod tests {
         // 40° by hand: ((cos 40° - cos 45°) / (cos 30° - cos 45°))^4 = (0.058939 / 0.158919)^4 = 0.018920.
         assert!((at(40.0) - 0.018920).abs() < 1e-4, "{}", at(40.0));
         assert!(at(35.0) > at(40.0) && at(35.0) < 1.0);
-        assert!(light.sample(Vec3::new(2.1, 0.0, 0.0), Vec2::ZERO).is_none(), "46° off the axis: dark");
-        assert!(light.sample(Vec3::new(0.0, 3.0, 0.0), Vec2::ZERO).is_none(), "behind the light: dark");
+        assert!(light.sample(Vec3::new(2.1, 0.0, 0.0), Vec3::Y, Vec2::ZERO).is_none(), "46° off the axis: dark");
+        assert!(light.sample(Vec3::new(0.0, 3.0, 0.0), Vec3::Y, Vec2::ZERO).is_none(), "behind the light: dark");
     }
 
     #[test]
