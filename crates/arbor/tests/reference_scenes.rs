@@ -23,10 +23,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use arbor::accel::AccelConfig;
+use arbor::film::Film;
 use arbor::image_io::metrics::{compare_blocks_rgb8, compare_rgb8};
 use arbor::image_io::{is_hdr_path, read_image, read_rgb8};
 use arbor::render::{render, RenderOptions};
-use arbor::film::Film;
 use arbor::scene::{load_desc, Scene};
 use arbor::tonemap::luminance;
 

@@ -37,6 +37,8 @@ mod tests {
         assert_eq!(s.wi, Vec3::Y);
         assert_eq!(s.dist, 2.0);
         assert_eq!(s.irradiance, Vec3::splat(25.0));
-        assert!(PointLight { position: Vec3::ZERO, intensity: Vec3::ONE }.sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO).is_none());
+        assert!(PointLight { position: Vec3::ZERO, intensity: Vec3::ONE }
+            .sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO)
+            .is_none());
     }
 }

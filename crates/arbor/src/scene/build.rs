@@ -73,7 +73,8 @@ impl Scene {
 /// missing mesh: located where the file names it.
 fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
-    EnvMap::load(path).map(Some).map_err(|e| match e {
+    let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
+    map.map(Some).map_err(|e| match e {
         Error::Io { source, .. } => Error::input(
             desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
             format!("cannot read environment map '{}': {source}", path.display()),

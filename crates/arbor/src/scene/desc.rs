@@ -52,8 +52,11 @@ pub struct SceneDesc {
     pub materials: Vec<MaterialDesc>,
     /// Objects, in file order.
     pub objects: Vec<ObjectDesc>,
-    /// A lat-long environment image seen by rays that miss (`SphericalDirectionalLight`).
+    /// The environment image of a `SphericalDirectionalLight`: it lights the scene and rays that miss
+    /// see it.
     pub environment: Option<PathBuf>,
+    /// True when `environment` is a light probe (`type="probe"`), false for a lat-long map.
+    pub environment_probe: bool,
     /// Where the file names `environment`, for the message when it cannot be read.
     pub environment_loc: Option<Location>,
     /// Things in the file that Arbor read but does not render (textures, motion blur...), one line each.
@@ -82,6 +85,7 @@ impl SceneDesc {
             materials: Vec::new(),
             objects: Vec::new(),
             environment: None,
+            environment_probe: false,
             environment_loc: None,
             warnings: Vec::new(),
         }

@@ -324,6 +324,16 @@ impl Reader<'_> {
                         self.notes.plain(n.loc(p), msg);
                     }
                     self.desc.environment = Some(self.dir.join(name));
+                    self.desc.environment_probe = match n.attr("type").map(|a| (a, a.trimmed())) {
+                        None | Some((_, "latlong")) => false,
+                        Some((_, "probe")) => true,
+                        Some((a, other)) => {
+                            let msg = format!(
+                                "<SphericalDirectionalLight>: unknown type '{other}' (expected latlong or probe)"
+                            );
+                            return Err(Error::input(a.loc(p), msg));
+                        }
+                    };
                     n.mark_used();
                     n.attr("id");
                     continue;
@@ -622,6 +632,11 @@ mod tests {
         let by_name = "<Lights><SphericalDirectionalLight id=\"1\"><EnvMapName>env.hdr</EnvMapName>\
                        </SphericalDirectionalLight></Lights>";
         assert_eq!(read_xml(by_name).unwrap().environment, Some(PathBuf::from("env.hdr")));
+        assert!(!read_xml(by_name).unwrap().environment_probe);
+        let probe = by_name.replace("id=\"1\">", "id=\"1\" type=\"probe\">");
+        assert!(read_xml(&probe).unwrap().environment_probe);
+        let e = read_xml(&probe.replace("probe", "cube")).unwrap_err();
+        assert!(e.to_string().ends_with("unknown type 'cube' (expected latlong or probe)"), "{e}");
         let missing = by_id.replace(">2<", ">3<");
         let e = read_xml(&missing).unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:144: <ImageId>: no <Image id=\"3\"> in <Textures><Images>");

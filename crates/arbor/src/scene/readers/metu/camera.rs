@@ -4,8 +4,8 @@
 
 use super::Reader;
 use crate::scene::desc::{CameraDesc, Lens, Window};
-use crate::tonemap::{Operator, Tonemap};
 use crate::scene::readers::tree::Node;
+use crate::tonemap::{Operator, Tonemap};
 use crate::{Error, Result};
 
 impl Reader<'_> {
