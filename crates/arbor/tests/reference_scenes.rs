@@ -374,3 +374,24 @@ fn reference_ceng795_2022_hw5_tone_mapping_of_official_exrs() {
     assert!(checked >= 4, "only {checked} EXRs checked");
     check(failures);
 }
+
+/// The relative-radiance rule on an official EXR: blind to the unit, not to a change of shape.
+#[test]
+fn reference_relative_radiance_ignores_the_unit_but_not_a_brighter_region() {
+    let Some(dir) = common::scenes_dir() else { return };
+    let exr = dir.join("ceng795-2022/hw5/outputs/glass_sphere_env.exr");
+    let reference = read_image(&exr).unwrap_or_else(|e| panic!("{e}"));
+    let scaled = Film { pixels: reference.pixels.iter().map(|&c| c * 255.0).collect(), ..reference.clone() };
+    assert_eq!(relative_radiance(&reference, &scaled, 1).0, 0.0);
+    assert_eq!(relative_radiance(&reference, &scaled, BLOCK).0, 0.0);
+    // A quarter of the image 30% brighter.
+    let mut changed = scaled.clone();
+    let w = changed.width as usize;
+    for (i, p) in changed.pixels.iter_mut().enumerate() {
+        if i % w < w / 2 && i / w < changed.height as usize / 2 {
+            *p *= 1.3;
+        }
+    }
+    let (share, _) = relative_radiance(&reference, &changed, BLOCK);
+    assert!(share > MAX_BLOCKS_OFF, "{share}");
+}
