@@ -141,6 +141,14 @@ impl EnvMap {
         Ok(cube(faces))
     }
 
+    /// The image of a latitude-longitude map; `None` for the other forms.
+    pub fn latlong(&self) -> Option<&Film> {
+        match &self.kind {
+            Kind::LatLong(film) => Some(film),
+            _ => None,
+        }
+    }
+
     /// True for a cube map, false for a latitude-longitude map.
     pub fn is_cube_map(&self) -> bool {
         matches!(self.kind, Kind::Cube { .. })

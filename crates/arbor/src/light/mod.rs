@@ -8,6 +8,7 @@
 mod area;
 mod directional;
 pub mod environment;
+mod latlong_sampling;
 mod point;
 mod spherical_directional;
 mod spot;

@@ -40,7 +40,7 @@ impl Scene {
         let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(build_light).collect();
         if let (Some(map), true) = (&environment, desc.environment.is_some()) {
             let units = 1.0 / desc.radiance_scale;
-            lights.push(Box::new(SphericalDirectionalLight { map: map.clone(), units }));
+            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units)));
         }
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
