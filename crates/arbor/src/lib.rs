@@ -27,6 +27,7 @@ pub mod mesh_io;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod tonemap;
 
 pub use arbor_accel::{accel, geometry};
 pub use error::{Error, Location, Result};

@@ -23,19 +23,25 @@ use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
-use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
+use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
 use crate::math::{Aabb, Vec3};
 use crate::{Error, Location, Result};
 
 impl Scene {
     /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
-    /// both levels. `environment` overrides the scene's own map.
+    /// both levels. `environment` overrides the scene's own map. A map the scene names
+    /// (`SphericalDirectionalLight`) also lights it; one given only by `environment` is background only.
     pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
             None => load_environment(&desc)?,
         };
+        let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(build_light).collect();
+        if let (Some(map), true) = (&environment, desc.environment.is_some()) {
+            let units = 1.0 / desc.radiance_scale;
+            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units)));
+        }
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
@@ -47,7 +53,7 @@ impl Scene {
             geometry,
             materials: desc.materials.iter().map(build_material).collect(),
             object_materials: desc.objects.iter().map(|o| o.material).collect(),
-            lights: desc.lights.iter().map(build_light).collect(),
+            lights,
             cameras: desc.cameras.iter().map(build_camera).collect(),
             environment,
             background: desc.background,
@@ -67,7 +73,8 @@ impl Scene {
 /// missing mesh: located where the file names it.
 fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
-    EnvMap::load(path).map(Some).map_err(|e| match e {
+    let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
+    map.map(Some).map_err(|e| match e {
         Error::Io { source, .. } => Error::input(
             desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
             format!("cannot read environment map '{}': {source}", path.display()),
@@ -98,6 +105,7 @@ pub fn build_camera(desc: &CameraDesc) -> Camera {
     camera.id = desc.id.clone();
     camera.image_name = desc.image_name.clone();
     camera.num_samples = desc.num_samples;
+    camera.tonemap = desc.tonemap;
     camera
 }
 
@@ -130,6 +138,13 @@ fn build_light(desc: &LightDesc) -> Box<dyn Light> {
             Box::new(AreaLight { position, normal, size, radiance })
         }
         LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+        LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
+            match SpotLight::new(position, direction, intensity, coverage_deg, falloff_deg) {
+                Some(spot) => Box::new(spot),
+                // The readers refuse a zero direction; a description made otherwise gets a dark light.
+                None => Box::new(PointLight { position, intensity: crate::math::Color::ZERO }),
+            }
+        }
     }
 }
 
@@ -305,6 +320,7 @@ mod tests {
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,
+            tonemap: None,
             loc: Location::file("x.xml"),
         }
     }
@@ -370,12 +386,12 @@ mod tests {
     fn build_light_maps_every_kind() {
         let p = Vec3::new(0.0, 0.0, 0.0);
         let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) });
-        assert_eq!(point.sample(p, Vec2::ZERO).unwrap().irradiance, Color::ONE);
+        assert_eq!(point.sample(p, Vec3::Y, Vec2::ZERO).unwrap().irradiance, Color::ONE);
         let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) });
-        assert_eq!(dir.sample(p, Vec2::ZERO).unwrap().wi, Vec3::Y);
+        assert_eq!(dir.sample(p, Vec3::Y, Vec2::ZERO).unwrap().wi, Vec3::Y);
         let area =
             LightDesc::Area { position: Vec3::Y * 4.0, normal: -Vec3::Y, size: 0.5, radiance: Color::splat(64.0) };
-        let s = build_light(&area).sample(p, Vec2::splat(0.5)).unwrap();
+        let s = build_light(&area).sample(p, Vec3::Y, Vec2::splat(0.5)).unwrap();
         assert!((s.irradiance.x - 64.0 * 0.25 / 16.0).abs() < 1e-5);
     }
 }
