@@ -54,6 +54,16 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             c.image_name,
             if c.orthographic { "  (orthographic)" } else { "" }
         );
+        if let Some(t) = &c.tonemap {
+            say!(
+                "  tonemap  {:?}  key {}  burn {}%  saturation {}  gamma {}",
+                t.operator,
+                t.key,
+                t.burn_percent,
+                t.saturation,
+                t.gamma
+            );
+        }
     }
     for l in &desc.lights {
         match l {
@@ -66,7 +76,17 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             LightDesc::Directional { direction, radiance } => {
                 say!("light      directional along {direction}, radiance {radiance}")
             }
+            LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
+                say!(
+                    "light      spot at {position} along {direction}, intensity {intensity}, coverage {coverage_deg}°, \
+                     fall-off {falloff_deg}°"
+                )
+            }
         }
+    }
+    if let Some(env) = &desc.environment {
+        let form = if desc.environment_probe { "light probe" } else { "lat-long" };
+        say!("light      environment {} ({form})", env.display());
     }
     for m in &desc.materials {
         let kind = match m.kind {

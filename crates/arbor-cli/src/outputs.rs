@@ -112,7 +112,7 @@ mod tests {
         assert_eq!(check_extension(Path::new("a.jpeg")), Ok(()));
         assert_eq!(
             check_extension(Path::new("a.bmp")),
-            Err("cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg".into())
+            Err("cannot write .bmp images; supported: png, ppm, exr, hdr, jpg, jpeg".into())
         );
     }
 

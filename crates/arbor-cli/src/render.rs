@@ -217,6 +217,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
+        // The tone-mapped PNG beside a high-dynamic-range image.
+        let mut extra = Vec::new();
         let (path, stats, window) = match &slice {
             Some(s) => {
                 let opts = RenderOptions { crop: s.window(cam)?, samples: Some(s.samples(spp)?), ..base.clone() };
@@ -244,7 +246,9 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                signals.writing(|| arbor::image_io::write_image(&target, &film))?;
+                let tonemap = if args.debug.is_some() { None } else { cam.tonemap.as_ref() };
+                let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap))?;
+                extra = written.into_iter().filter(|p| *p != target).collect();
                 (target, stats, window)
             }
         };
@@ -252,6 +256,9 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             summary(&args, &scene, &path, window, &stats, parse_time);
         }
         say!("Saved: {}", path.display());
+        for p in &extra {
+            say!("Saved: {}", p.display());
+        }
         if let Some(max) = stats.heatmap_max {
             // Printed even with --quiet: without it the heatmap's colours have no scale.
             say!("heatmap maximum {max} (nodes visited + primitives tested) for {}", path.display());

@@ -90,6 +90,14 @@ fn catalogue() -> Vec<Row> {
     render("focus_distance_zero.xml", 3, "error: focus_distance_zero.xml:10:13: Camera 1: FocusDistance 0 must be positive\n"),
     render("focus_distance_negative.json", 3, "error: focus_distance_negative.json:13:9: Camera 1: FocusDistance -5 must be positive\n"),
     render("area_light_zero_size.xml", 3, "error: area_light_zero_size.xml:18:13: AreaLight 1: Size 0 must be positive\n"),
+    // Tone mapping and spot lights (hw5) out of range.
+    render("tonemap_negative_key.xml", 3, "error: tonemap_negative_key.xml:13:17: Camera 1: TMOOptions key value -0.18 must be positive\n"),
+    render("tonemap_burn_out_of_range.xml", 3, "error: tonemap_burn_out_of_range.xml:13:17: Camera 1: TMOOptions burn-out percentage 101 must be in [0, 100]\n"),
+    render("tonemap_gamma_zero.xml", 3, "error: tonemap_gamma_zero.xml:15:17: Camera 1: Gamma 0 must be positive\n"),
+    render("tonemap_unknown_tmo.xml", 3, "error: tonemap_unknown_tmo.xml:12:17: Camera 1: unknown TMO 'Filmic' (expected Photographic)\n"),
+    render("spot_light_zero_coverage.xml", 3, "error: spot_light_zero_coverage.xml:19:13: SpotLight 1: CoverageAngle 0 must be in (0, 360] degrees\n"),
+    render("spot_light_falloff_above_coverage.xml", 3, "error: spot_light_falloff_above_coverage.xml:20:13: SpotLight 1: FalloffAngle 20 must be in (0, CoverageAngle 10]\n"),
+    render("spot_light_negative_falloff.xml", 3, "error: spot_light_negative_falloff.xml:20:13: SpotLight 1: FalloffAngle -5 must be in (0, CoverageAngle 30]\n"),
     render("area_light_negative_size.xml", 3, "error: area_light_negative_size.xml:18:13: AreaLight 1: Size -1 must be positive\n"),
     render("area_light_zero_normal.xml", 3, "error: area_light_zero_normal.xml:17:13: <Normal>: zero vector\n"),
     render("area_light_nan_radiance.xml", 3, "error: area_light_nan_radiance.xml:19:13: <Radiance>: non-finite number 'nan'\n"),
@@ -180,7 +188,7 @@ fn catalogue() -> Vec<Row> {
     cmd(&["bench", "sphere:100", "--accel-param", "depth=4"], 2, "error: --accel-param 'depth=4' is not KIND:KEY=VALUE\n"),
     // Merge: a part that is no partial EXR, or missing.
     cmd(&["merge", "truncated.xml", "-o", "OUT/merged.png"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
-    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg\n"),
+    cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, hdr, jpg, jpeg\n"),
     cmd(&["merge", "no_such_part.exr", "-o", "OUT/merged.png"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),

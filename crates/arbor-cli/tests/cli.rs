@@ -80,6 +80,33 @@ fn cli_writes_the_format_the_scene_names() {
 }
 
 #[test]
+fn cli_hdr_image_with_a_tonemap_gets_a_tone_mapped_png_beside_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tonemap = "<ImageName>tiny.IMAGE_EXT</ImageName>\n<Tonemap><TMO>Photographic</TMO>\
+                   <TMOOptions>0.18 1</TMOOptions><Saturation>1</Saturation><Gamma>2.2</Gamma></Tonemap>";
+    for ext in ["exr", "hdr"] {
+        let text = TINY.replace("<ImageName>tiny.IMAGE_EXT</ImageName>", tonemap).replace("IMAGE_EXT", ext);
+        let scene = write(tmp.path(), &format!("t_{ext}.xml"), &text);
+        let o = arbor(&["render", "-q", scene.to_str().unwrap(), "-o", ext], tmp.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (image, png) = (tmp.path().join(format!("{ext}/tiny.{ext}")), tmp.path().join(format!("{ext}/tiny.png")));
+        assert_eq!(
+            stdout(&o),
+            format!(
+                "Saved: {}\nSaved: {}\n",
+                Path::new(ext).join(format!("tiny.{ext}")).display(),
+                Path::new(ext).join("tiny.png").display()
+            )
+        );
+        let magic: &[u8] = if ext == "exr" { b"\x76\x2f\x31\x01" } else { b"#?RADIANCE" };
+        assert!(std::fs::read(&image).unwrap().starts_with(magic), "{ext} output has the wrong signature");
+        assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+        let names: Vec<_> = std::fs::read_dir(tmp.path().join(ext)).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 2, "no temporary files left: {names:?}");
+    }
+}
+
+#[test]
 fn cli_usage_error_exits_2() {
     let tmp = tempfile::tempdir().unwrap();
     assert_eq!(arbor(&["render", "--spp", "zero"], tmp.path()).status.code(), Some(2));

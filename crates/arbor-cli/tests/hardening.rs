@@ -301,7 +301,7 @@ fn hardening_o_names_an_image_or_a_folder() {
     assert!(o.status.success() && tmp.path().join("b.png").is_file(), "{}", stderr(&o));
     let o = arbor(&["render", "one.xml", "-o", "out.bmp"], tmp.path());
     assert_eq!(o.status.code(), Some(2));
-    assert_eq!(stderr(&o), "error: cannot write .bmp images; supported: png, ppm, exr, jpg, jpeg\n");
+    assert_eq!(stderr(&o), "error: cannot write .bmp images; supported: png, ppm, exr, hdr, jpg, jpeg\n");
     assert_eq!(entries(tmp.path()), ["b.png", "one.xml", "out.jpg", "two.xml"]);
 }
 
@@ -312,7 +312,7 @@ fn hardening_output_paths_are_checked_before_rendering() {
     std::fs::write(tmp.path().join("tga.xml"), &text).unwrap();
     let o = arbor(&["render", "tga.xml", "-o", "out"], tmp.path());
     let want = format!(
-        "error: tga.xml:{}: Camera 1: ImageName 's.tga': cannot write .tga images; supported: png, ppm, exr, jpg, jpeg\n",
+        "error: tga.xml:{}: Camera 1: ImageName 's.tga': cannot write .tga images; supported: png, ppm, exr, hdr, jpg, jpeg\n",
         position(&text, "<Camera ")
     );
     assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));

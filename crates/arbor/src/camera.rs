@@ -10,6 +10,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::math::{orthonormal_basis, Ray, Vec2, Vec3};
+use crate::tonemap::Tonemap;
 
 /// The window `left right bottom top` on the image plane, `distance` along the gaze from the eye.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,6 +62,8 @@ pub struct Camera {
     pub image_name: String,
     /// Samples per pixel, at least 1.
     pub num_samples: u32,
+    /// How the image is tone mapped for display; none: radiance as it is.
+    pub tonemap: Option<Tonemap>,
 }
 
 impl Camera {
@@ -92,6 +95,7 @@ impl Camera {
             id: String::new(),
             image_name: String::new(),
             num_samples: 1,
+            tonemap: None,
         }
     }
 

@@ -28,6 +28,7 @@ pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod texture;
+pub mod tonemap;
 
 pub use arbor_accel::{accel, geometry};
 pub use error::{Error, Location, Result};

@@ -70,6 +70,7 @@ fn scene(materials: Vec<MaterialDesc>, objects: Vec<ObjectDesc>, lights: Vec<Lig
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,
+        tonemap: None,
         loc: Location::file("test"),
     });
     d

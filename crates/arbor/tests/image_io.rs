@@ -123,7 +123,7 @@ fn write_unknown_extension_names_it_and_keeps_old_file() {
     fs::write(&path, b"old contents").unwrap();
     let err = write_image(&path, &level_film(2, 2)).unwrap_err().to_string();
     assert!(err.contains("\".bmp\""), "{err}");
-    assert!(err.contains("png, ppm, exr, jpg, jpeg"), "{err}");
+    assert!(err.contains("png, ppm, exr, hdr, jpg, jpeg"), "{err}");
     assert_eq!(fs::read(&path).unwrap(), b"old contents");
     assert_eq!(strays(dir.path(), &["out.bmp"]), Vec::<String>::new());
 
@@ -361,4 +361,32 @@ fn write_into_a_read_only_folder_names_the_target_not_the_temporary() {
     assert!(err.is_io(), "{err}");
     let msg = err.to_string();
     assert!(msg.starts_with(&format!("{}: ", target.display())) && !msg.contains(".tmp"), "{msg}");
+}
+
+#[test]
+fn write_outputs_hdr_image_gets_a_tone_mapped_png_beside() {
+    use arbor::image_io::write_outputs;
+    use arbor::tonemap::{Operator, Tonemap};
+    let dir = tempfile::tempdir().unwrap();
+    let film = Film { width: 2, height: 1, pixels: vec![Color::new(0.5, 2.0, 40.0), Color::splat(3.0)] };
+    let tm = Tonemap { operator: Operator::Photographic, key: 0.18, burn_percent: 1.0, saturation: 1.0, gamma: 2.2 };
+    for ext in ["exr", "hdr"] {
+        let path = dir.path().join(format!("out.{ext}"));
+        let written = write_outputs(&path, &film, Some(&tm)).unwrap();
+        assert_eq!(written, vec![path.clone(), dir.path().join("out.png")]);
+        let back = read_image(&path).unwrap();
+        for (a, b) in back.pixels.iter().zip(&film.pixels) {
+            // RGBE keeps 8 bits of mantissa per channel, relative to the largest channel.
+            assert!((*a - *b).abs().max_element() <= 0.01 * b.max_element(), "{ext}: {a} vs {b}");
+        }
+        let (_, _, png) = read_rgb8(&dir.path().join("out.png")).unwrap();
+        assert_eq!(png, tm.apply(&film).to_rgb8());
+    }
+    // Without a tone mapping, only the image asked for; an 8-bit one with it gets the mapped values.
+    let plain = dir.path().join("plain.exr");
+    assert_eq!(write_outputs(&plain, &film, None).unwrap(), vec![plain.clone()]);
+    assert!(!dir.path().join("plain.png").exists());
+    let ldr = dir.path().join("ldr.png");
+    assert_eq!(write_outputs(&ldr, &film, Some(&tm)).unwrap(), vec![ldr.clone()]);
+    assert_eq!(read_rgb8(&ldr).unwrap().2, tm.apply(&film).to_rgb8());
 }

@@ -216,6 +216,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             num_samples: 1,
             transform: Transform::IDENTITY,
             lens: None,
+            tonemap: None,
             loc: Location::file("test"),
         });
         let s = Scene::build(d, &AccelConfig::default(), None).unwrap();

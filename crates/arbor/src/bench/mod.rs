@@ -87,6 +87,7 @@ pub fn framing_camera(bounds: Aabb, width: u32, height: u32) -> CameraDesc {
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,
+        tonemap: None,
         loc: Location::file("bench"),
     }
 }

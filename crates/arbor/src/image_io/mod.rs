@@ -4,6 +4,8 @@
 //!   [`Film::to_rgb8`](crate::film::Film::to_rgb8)) or to OpenEXR (32-bit float RGB, unclamped). Writes are
 //!   atomic: the image goes to a temporary file in the target's directory which is then renamed over the
 //!   target, so a failed run never leaves a half-written image and never destroys the previous one.
+//!   Radiance HDR (`.hdr`) too. [`write_outputs`] adds a camera's tone mapping
+//!   ([`Tonemap`](crate::tonemap::Tonemap)): a high-dynamic-range image plus a tone-mapped PNG beside it.
 //! - [`read_image`]: PNG, JPEG, PNM, OpenEXR, Radiance HDR into a film in display units (integer samples
 //!   divided by their maximum, float samples as they are); [`read_rgb8`] for exact 8-bit comparisons.
 //! - [`metrics`]: PSNR, RMSE, bias and the share of differing pixels (or KxK-pixel block means, for noisy
@@ -19,4 +21,4 @@ pub use metrics::{
     compare_blocks_files, compare_blocks_rgb8, compare_files, compare_rgb8, diff_image, BlockComparison, Comparison,
 };
 pub use read::{read_image, read_rgb8};
-pub use write::{write_image, SUPPORTED_WRITE_EXTENSIONS};
+pub use write::{is_hdr_path, tone_mapped_beside, write_image, write_outputs, SUPPORTED_WRITE_EXTENSIONS};

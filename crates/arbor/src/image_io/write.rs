@@ -11,6 +11,7 @@ use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use image::codecs::hdr::HdrEncoder;
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
@@ -18,9 +19,10 @@ use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{Error, Result};
 use crate::film::Film;
+use crate::tonemap::Tonemap;
 
 /// The extensions [`write_image`] understands (compared case-insensitively).
-pub const SUPPORTED_WRITE_EXTENSIONS: &[&str] = &["png", "ppm", "exr", "jpg", "jpeg"];
+pub const SUPPORTED_WRITE_EXTENSIONS: &[&str] = &["png", "ppm", "exr", "hdr", "jpg", "jpeg"];
 
 /// JPEG quality (of 100): high enough that the 8-bit quantisation, not the compression, dominates.
 const JPEG_QUALITY: u8 = 95;
@@ -31,6 +33,8 @@ enum Format {
     Rgb8(Rgb8),
     /// 32-bit float RGB, through the exr crate.
     Exr,
+    /// Radiance RGBE, through the image crate.
+    Hdr,
 }
 
 #[derive(Clone, Copy)]
@@ -42,7 +46,8 @@ enum Rgb8 {
 
 /// Writes `film` to `path`, choosing the format by the extension (case-insensitive): `png` (8-bit RGB),
 /// `ppm` (binary P6, 8-bit), `jpg`/`jpeg` (8-bit, quality 95, from the same 8-bit values as PNG) or
-/// `exr` (32-bit float RGB, values as they are, including > 1 and < 0).
+/// `exr` (32-bit float RGB, values as they are, including > 1 and < 0) or `hdr` (Radiance RGBE, which
+/// holds no negative values: those become 0).
 ///
 /// The parent directory is created when missing. The write is atomic: on failure an existing file at
 /// `path` is left untouched and no temporary file remains.
@@ -68,6 +73,7 @@ fn format_of(path: &Path) -> Result<Format> {
         Some("png") => Ok(Format::Rgb8(Rgb8::Png)),
         Some("ppm") => Ok(Format::Rgb8(Rgb8::Ppm)),
         Some("exr") => Ok(Format::Exr),
+        Some("hdr") => Ok(Format::Hdr),
         Some("jpg" | "jpeg") => Ok(Format::Rgb8(Rgb8::Jpeg)),
         other => {
             let named = match other {
@@ -86,6 +92,7 @@ fn format_of(path: &Path) -> Result<Format> {
 fn encode(film: &Film, format: Format) -> std::result::Result<Vec<u8>, String> {
     match format {
         Format::Exr => encode_exr(film).map_err(|e| e.to_string()),
+        Format::Hdr => encode_hdr(film).map_err(|e| e.to_string()),
         Format::Rgb8(f) => encode_rgb8(film, f).map_err(|e| e.to_string()),
     }
 }
@@ -101,6 +108,15 @@ fn encode_exr(film: &Film) -> exr::error::Result<Vec<u8>> {
     let mut out = Cursor::new(Vec::new());
     Image::from_channels((w, film.height as usize), channels).write().to_buffered(&mut out)?;
     Ok(out.into_inner())
+}
+
+fn encode_hdr(film: &Film) -> image::ImageResult<Vec<u8>> {
+    let positive = |v: f32| if v > 0.0 { v.min(f32::MAX) } else { 0.0 };
+    let pixels: Vec<image::Rgb<f32>> =
+        film.pixels.iter().map(|c| image::Rgb([positive(c.x), positive(c.y), positive(c.z)])).collect();
+    let mut out = Vec::new();
+    HdrEncoder::new(&mut out).encode(&pixels, film.width as usize, film.height as usize)?;
+    Ok(out)
 }
 
 fn encode_rgb8(film: &Film, format: Rgb8) -> image::ImageResult<Vec<u8>> {
@@ -122,6 +138,35 @@ fn encode_rgb8(film: &Film, format: Rgb8) -> image::ImageResult<Vec<u8>> {
         )?,
     }
     Ok(out.into_inner())
+}
+
+/// True when `path` names a high-dynamic-range format (`exr`, `hdr`).
+pub fn is_hdr_path(path: &Path) -> bool {
+    matches!(format_of(path), Ok(Format::Exr | Format::Hdr))
+}
+
+/// The tone-mapped PNG written beside the high-dynamic-range image `path` (the course's rule).
+pub fn tone_mapped_beside(path: &Path) -> PathBuf {
+    path.with_extension("png")
+}
+
+/// Writes a camera's image: `film` as it is to `path`, except that with a `tonemap` an 8-bit format gets
+/// the tone-mapped film, and a high-dynamic-range one gets the film as it is plus the tone-mapped PNG
+/// beside it ([`tone_mapped_beside`]). Returns the files written, each written atomically.
+pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Result<Vec<PathBuf>> {
+    let Some(tm) = tonemap else {
+        write_image(path, film)?;
+        return Ok(vec![path.to_path_buf()]);
+    };
+    if is_hdr_path(path) {
+        write_image(path, film)?;
+        let png = tone_mapped_beside(path);
+        write_image(&png, &tm.apply(film))?;
+        Ok(vec![path.to_path_buf(), png])
+    } else {
+        write_image(path, &tm.apply(film))?;
+        Ok(vec![path.to_path_buf()])
+    }
 }
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.

@@ -110,7 +110,7 @@ impl<'a> Whitted<'a> {
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
         let shadow_origin = spawn_origin(scene.offset, &s, ng);
         for light in scene.lights.iter().filter(|_| local) {
-            let Some(ls) = light.sample(s.p, rng.next_2d()) else { continue };
+            let Some(ls) = light.sample(s.p, ns, rng.next_2d()) else { continue };
             if ns.dot(ls.wi) <= 0.0 {
                 continue;
             }

@@ -20,7 +20,7 @@ pub struct AreaLight {
 
 impl Light for AreaLight {
     /// The light of the point `u` (in `[0,1)²`) of the square reaching `p`.
-    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+    fn sample(&self, p: Vec3, _n: Vec3, u: Vec2) -> Option<LightSample> {
         let AreaLight { position, normal, size, radiance } = *self;
         sample_area(position, normal, size, radiance, p, u)
     }

@@ -14,7 +14,7 @@ pub struct DirectionalLight {
 
 impl Light for DirectionalLight {
     /// The light reaching any point: from `-direction`, unattenuated, from infinitely far.
-    fn sample(&self, _p: Vec3, _u: Vec2) -> Option<LightSample> {
+    fn sample(&self, _p: Vec3, _n: Vec3, _u: Vec2) -> Option<LightSample> {
         let wi = -self.direction.try_normalize()?;
         Some(LightSample { wi, dist: f32::INFINITY, irradiance: self.radiance })
     }
@@ -27,10 +27,10 @@ mod tests {
     #[test]
     fn directional_light_comes_from_against_its_direction() {
         let light = DirectionalLight { direction: Vec3::new(0.0, -2.0, 0.0), radiance: Color::splat(3.0) };
-        let s = light.sample(Vec3::new(5.0, 1.0, -2.0), Vec2::ZERO).unwrap();
+        let s = light.sample(Vec3::new(5.0, 1.0, -2.0), Vec3::Y, Vec2::ZERO).unwrap();
         assert_eq!(s, LightSample { wi: Vec3::Y, dist: f32::INFINITY, irradiance: Color::splat(3.0) });
         assert!(DirectionalLight { direction: Vec3::ZERO, radiance: Color::ONE }
-            .sample(Vec3::ZERO, Vec2::ZERO)
+            .sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO)
             .is_none());
     }
 }

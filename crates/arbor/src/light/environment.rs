@@ -13,6 +13,13 @@
 //! Pixel `(i, j)` covers `u` in `[i, i + 1] / width`, its centre at `(i + 0.5) / width`. Filtering wraps
 //! horizontally and clamps at the poles.
 //!
+//! # Light probes (angular maps)
+//! Debevec's light probe format (<https://www.pauldebevec.com/Probes/>): a disc filling a square image,
+//! its centre looking down -z like a lat-long map's. For the unit direction `d`,
+//! `r = acos(-d.z) / (pi sqrt(d.x² + d.y²))` and the image point `(s, t) = (d.x r, d.y r)` in `[-1, 1]²`
+//! (`t` up), so the angle from -z grows linearly with the distance from the centre and the rim is +z.
+//! Filtering is bilinear, clamped at the border.
+//!
 //! # Cube maps
 //! Six square faces of equal size, oriented as in OpenGL and RenderMan
 //! (<https://www.khronos.org/opengl/wiki/Cubemap_Texture>): the face is the axis of the largest component
@@ -70,6 +77,7 @@ pub struct EnvMap {
 #[derive(Debug, Clone, PartialEq)]
 enum Kind {
     LatLong(Film),
+    Probe(Film),
     Cube { size: u32, faces: Box<[Film; 6]> },
 }
 
@@ -105,11 +113,40 @@ impl EnvMap {
         EnvMap { kind: Kind::LatLong(film) }
     }
 
+    /// A light probe (angular map) from a file: see the module documentation.
+    pub fn load_probe(path: &Path) -> Result<EnvMap> {
+        let film = read_image(path)?;
+        if film.pixels.is_empty() {
+            return Err(Error::input(Location::file(path), "the environment map is empty"));
+        }
+        Ok(EnvMap { kind: Kind::Probe(film) })
+    }
+
+    /// A light probe (angular map) from an image in memory.
+    ///
+    /// # Panics
+    /// When the film is empty or its pixel count is not `width * height` (a caller's bug).
+    pub fn from_film_probe(film: Film) -> EnvMap {
+        assert!(
+            film.width > 0 && film.pixels.len() == film.width as usize * film.height as usize,
+            "light probe film must be non-empty and consistent"
+        );
+        EnvMap { kind: Kind::Probe(film) }
+    }
+
     /// A cube map from six faces in the order `+x -x +y -y +z -z` ([`FACE_LABELS`]). The faces must be
     /// square, non-empty and of one size.
     pub fn from_faces(faces: [Film; 6]) -> Result<EnvMap> {
         check_faces(&faces).map_err(|(face, msg)| Error::Invalid(format!("cube face {}: {msg}", FACE_LABELS[face])))?;
         Ok(cube(faces))
+    }
+
+    /// The image of a latitude-longitude map; `None` for the other forms.
+    pub fn latlong(&self) -> Option<&Film> {
+        match &self.kind {
+            Kind::LatLong(film) => Some(film),
+            _ => None,
+        }
     }
 
     /// True for a cube map, false for a latitude-longitude map.
@@ -124,6 +161,7 @@ impl EnvMap {
         }
         match &self.kind {
             Kind::LatLong(film) => eval_latlong(film, dir),
+            Kind::Probe(film) => eval_probe(film, dir),
             Kind::Cube { size, faces } => eval_cube(faces, *size, dir),
         }
     }
@@ -201,6 +239,30 @@ fn eval_latlong(film: &Film, dir: Vec3) -> Color {
     // Wrap in longitude; clamp at the poles, where a row is a single point.
     let px = |i: i64| i.rem_euclid(w) as u32;
     let py = |j: i64| j.clamp(0, h - 1) as u32;
+    let row = |j: i64| film.get(px(x0), py(j)).lerp(film.get(px(x0 + 1), py(j)), fx);
+    row(y0).lerp(row(y0 + 1), fy)
+}
+
+/// Bilinear lookup in a light probe, clamped at the image's border (the disc's rim is one direction).
+fn eval_probe(film: &Film, dir: Vec3) -> Color {
+    let d = dir.normalize();
+    let rho = (d.x * d.x + d.y * d.y).sqrt();
+    // Straight behind the centre every point of the rim is the same direction; take the right one.
+    let (sx, sy) = if rho > 0.0 {
+        let r = (-d.z).clamp(-1.0, 1.0).acos() / (PI * rho);
+        (d.x * r, d.y * r)
+    } else if d.z < 0.0 {
+        (0.0, 0.0)
+    } else {
+        (1.0, 0.0)
+    };
+    let x = (sx + 1.0) * 0.5 * film.width as f32 - 0.5;
+    let y = (1.0 - sy) * 0.5 * film.height as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let px = |i: i64| i.clamp(0, film.width as i64 - 1) as u32;
+    let py = |j: i64| j.clamp(0, film.height as i64 - 1) as u32;
     let row = |j: i64| film.get(px(x0), py(j)).lerp(film.get(px(x0 + 1), py(j)), fx);
     row(y0).lerp(row(y0 + 1), fy)
 }
@@ -462,5 +524,22 @@ mod tests {
         faces[5] = film(2, 2, |_, _| NZ);
         let err = EnvMap::from_faces(faces).unwrap_err().to_string();
         assert!(err.contains("cube face -z") && err.contains("is 2x2 but face +x is 4x4"), "{err}");
+    }
+
+    #[test]
+    fn probe_centre_looks_down_minus_z_and_angle_grows_linearly_to_the_rim() {
+        // 4x4 probe, pixel (i, j) holds 4 j + i.
+        let film = Film { width: 4, height: 4, pixels: (0..16).map(|k| Color::splat(k as f32)).collect() };
+        let map = EnvMap::from_film_probe(film);
+        // -z is the centre, (s, t) = (0, 0): pixel coordinates (1.5, 1.5), the mean of 5, 6, 9, 10.
+        assert_eq!(map.eval(-Vec3::Z), Color::splat(7.5));
+        // 45° from -z towards +x: a quarter of the way to the rim, (0.25, 0): (2.0, 1.5), pixels 6 and 10.
+        assert_eq!(map.eval(Vec3::new(1.0, 0.0, -1.0)), Color::splat(8.0));
+        // +x, 90° away: half way, (0.5, 0): (2.5, 1.5), pixels 6, 7, 10, 11. +y: (0, 0.5): (1.5, 0.5),
+        // pixels 1, 2, 5, 6.
+        assert_eq!(map.eval(Vec3::X), Color::splat(8.5));
+        assert_eq!(map.eval(Vec3::Y), Color::splat(3.5));
+        // +z is the rim: (1, 0), (3.5, 1.5) clamped to column 3, pixels 7 and 11.
+        assert_eq!(map.eval(Vec3::Z), Color::splat(9.0));
     }
 }

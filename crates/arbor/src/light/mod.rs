@@ -8,7 +8,10 @@
 mod area;
 mod directional;
 pub mod environment;
+mod latlong_sampling;
 mod point;
+mod spherical_directional;
+mod spot;
 
 use std::fmt;
 
@@ -17,6 +20,8 @@ use crate::math::{Color, Vec2, Vec3};
 pub use area::AreaLight;
 pub use directional::DirectionalLight;
 pub use point::PointLight;
+pub use spherical_directional::SphericalDirectionalLight;
+pub use spot::SpotLight;
 
 /// Light arriving at a point from one light (or one point on an area light).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,7 +36,8 @@ pub struct LightSample {
 
 /// A light source other than the ambient light and the environment.
 pub trait Light: fmt::Debug + Send + Sync {
-    /// The light reaching point `p`; `u` (in `[0,1)²`) picks the point on a light with an area.
-    /// `None` when nothing arrives (`p` on a point light, a zero direction).
-    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample>;
+    /// The light reaching point `p` of a surface whose (unit) normal on the lit side is `n`; `u` (in
+    /// `[0,1)²`) picks the point on a light with an area, or the direction of an environment. `None` when
+    /// nothing arrives (`p` on a point light, a zero direction).
+    fn sample(&self, p: Vec3, n: Vec3, u: Vec2) -> Option<LightSample>;
 }

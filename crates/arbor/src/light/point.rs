@@ -13,7 +13,7 @@ pub struct PointLight {
 }
 
 impl Light for PointLight {
-    fn sample(&self, p: Vec3, _u: Vec2) -> Option<LightSample> {
+    fn sample(&self, p: Vec3, _n: Vec3, _u: Vec2) -> Option<LightSample> {
         let to_light = self.position - p;
         let d2 = to_light.length_squared();
         // Negated so that a NaN distance (a NaN point) gives no light, as a zero one does.
@@ -33,10 +33,12 @@ mod tests {
     #[test]
     fn point_light_falls_off_with_square_distance() {
         let light = PointLight { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(100.0) };
-        let s = light.sample(Vec3::ZERO, Vec2::ZERO).unwrap();
+        let s = light.sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO).unwrap();
         assert_eq!(s.wi, Vec3::Y);
         assert_eq!(s.dist, 2.0);
         assert_eq!(s.irradiance, Vec3::splat(25.0));
-        assert!(PointLight { position: Vec3::ZERO, intensity: Vec3::ONE }.sample(Vec3::ZERO, Vec2::ZERO).is_none());
+        assert!(PointLight { position: Vec3::ZERO, intensity: Vec3::ONE }
+            .sample(Vec3::ZERO, Vec3::Y, Vec2::ZERO)
+            .is_none());
     }
 }

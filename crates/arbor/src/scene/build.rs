@@ -23,9 +23,9 @@ use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
-use crate::light::{AreaLight, DirectionalLight, Light, PointLight};
+use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
 use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
-use crate::math::Aabb;
+use crate::math::{Aabb, Vec3};
 use crate::texture::Decal;
 use crate::{Error, Location, Result};
 
@@ -33,12 +33,18 @@ mod textures;
 
 impl Scene {
     /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
-    /// both levels. `environment` overrides the scene's own map.
+    /// both levels. `environment` overrides the scene's own map. A map the scene names
+    /// (`SphericalDirectionalLight`) also lights it; one given only by `environment` is background only.
     pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
             None => load_environment(&desc)?,
         };
+        let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(build_light).collect();
+        if let (Some(map), true) = (&environment, desc.environment.is_some()) {
+            let units = 1.0 / desc.radiance_scale;
+            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units)));
+        }
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
         let textures = textures::build_textures(&desc)?;
@@ -54,7 +60,7 @@ impl Scene {
             background_texture: textures.iter().position(|t| t.decal == Decal::ReplaceBackground),
             object_textures: desc.objects.iter().map(|o| o.textures.clone()).collect(),
             textures,
-            lights: desc.lights.iter().map(build_light).collect(),
+            lights,
             cameras: desc.cameras.iter().map(build_camera).collect(),
             environment,
             background: desc.background,
@@ -74,7 +80,8 @@ impl Scene {
 /// missing mesh: located where the file names it.
 fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
-    EnvMap::load(path).map(Some).map_err(|e| match e {
+    let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
+    map.map(Some).map_err(|e| match e {
         Error::Io { source, .. } => Error::input(
             desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
             format!("cannot read environment map '{}': {source}", path.display()),
@@ -105,6 +112,7 @@ pub fn build_camera(desc: &CameraDesc) -> Camera {
     camera.id = desc.id.clone();
     camera.image_name = desc.image_name.clone();
     camera.num_samples = desc.num_samples;
+    camera.tonemap = desc.tonemap;
     camera
 }
 
@@ -137,6 +145,13 @@ fn build_light(desc: &LightDesc) -> Box<dyn Light> {
             Box::new(AreaLight { position, normal, size, radiance })
         }
         LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+        LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
+            match SpotLight::new(position, direction, intensity, coverage_deg, falloff_deg) {
+                Some(spot) => Box::new(spot),
+                // The readers refuse a zero direction; a description made otherwise gets a dark light.
+                None => Box::new(PointLight { position, intensity: crate::math::Color::ZERO }),
+            }
+        }
     }
 }
 
@@ -182,7 +197,11 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             ShapeDesc::Plane { point, normal } => {
                 let point = object.transform.point(*point);
                 let normal = object.transform.normal(*normal).normalize();
-                planes.push(ScenePlane { plane: Plane { point, normal }, object: index as u32, motion: object.motion });
+                planes.push(ScenePlane {
+                    plane: Plane { point, normal },
+                    object: index as u32,
+                    motion: moving(object),
+                });
                 continue;
             }
             ShapeDesc::Instance { .. } => unreachable!("resolve_instance never returns an instance"),
@@ -200,7 +219,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
         let object = SceneObject {
             transform: if matches!(shape, Shape::Sphere(_)) { None } else { transform },
             shape,
-            motion: object.motion,
+            motion: moving(object),
             bounds,
             object: index as u32,
             first_prim,
@@ -214,6 +233,11 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     counts.objects = objects.len();
     let top = spec.build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
+}
+
+/// An object's motion over the shutter interval, `None` when it stands still.
+fn moving(object: &ObjectDesc) -> Option<Vec3> {
+    (object.motion != Vec3::ZERO).then_some(object.motion)
 }
 
 /// A mesh ready for rendering: smooth meshes get vertex normals (from the file, or averaged from the
@@ -303,6 +327,7 @@ mod tests {
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,
+            tonemap: None,
             loc: Location::file("x.xml"),
         }
     }
@@ -368,12 +393,12 @@ mod tests {
     fn build_light_maps_every_kind() {
         let p = Vec3::new(0.0, 0.0, 0.0);
         let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) });
-        assert_eq!(point.sample(p, Vec2::ZERO).unwrap().irradiance, Color::ONE);
+        assert_eq!(point.sample(p, Vec3::Y, Vec2::ZERO).unwrap().irradiance, Color::ONE);
         let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) });
-        assert_eq!(dir.sample(p, Vec2::ZERO).unwrap().wi, Vec3::Y);
+        assert_eq!(dir.sample(p, Vec3::Y, Vec2::ZERO).unwrap().wi, Vec3::Y);
         let area =
             LightDesc::Area { position: Vec3::Y * 4.0, normal: -Vec3::Y, size: 0.5, radiance: Color::splat(64.0) };
-        let s = build_light(&area).sample(p, Vec2::splat(0.5)).unwrap();
+        let s = build_light(&area).sample(p, Vec3::Y, Vec2::splat(0.5)).unwrap();
         assert!((s.irradiance.x - 64.0 * 0.25 / 16.0).abs() < 1e-5);
     }
 }

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
+use crate::tonemap::Tonemap;
 use crate::Location;
 
 mod texture;
@@ -54,8 +55,11 @@ pub struct SceneDesc {
     pub materials: Vec<MaterialDesc>,
     /// Objects, in file order.
     pub objects: Vec<ObjectDesc>,
-    /// A lat-long environment image seen by rays that miss (`SphericalDirectionalLight`).
+    /// The environment image of a `SphericalDirectionalLight`: it lights the scene and rays that miss
+    /// see it.
     pub environment: Option<PathBuf>,
+    /// True when `environment` is a light probe (`type="probe"`), false for a lat-long map.
+    pub environment_probe: bool,
     /// Where the file names `environment`, for the message when it cannot be read.
     pub environment_loc: Option<Location>,
     /// Image files of texture maps, each once.
@@ -88,6 +92,7 @@ impl SceneDesc {
             materials: Vec::new(),
             objects: Vec::new(),
             environment: None,
+            environment_probe: false,
             environment_loc: None,
             images: Vec::new(),
             textures: Vec::new(),
@@ -159,6 +164,8 @@ pub struct CameraDesc {
     pub transform: Transform,
     /// Depth of field, when the file asks for it with a non-zero aperture.
     pub lens: Option<Lens>,
+    /// Tone mapping of the image (`Tonemap`); none: radiance written as it is.
+    pub tonemap: Option<Tonemap>,
     /// Where the camera is defined.
     pub loc: Location,
 }
@@ -190,6 +197,20 @@ pub enum LightDesc {
         direction: Vec3,
         /// Irradiance on a surface facing it.
         radiance: Color,
+    },
+    /// A point light emitting in a cone around `direction` (full angles in degrees,
+    /// `0 < falloff_deg <= coverage_deg <= 360`).
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Axis of the cone (unit).
+        direction: Vec3,
+        /// Intensity inside the fall-off cone.
+        intensity: Color,
+        /// Full angle of the cone outside which no light leaves.
+        coverage_deg: f32,
+        /// Full angle of the cone inside which the light is a point light.
+        falloff_deg: f32,
     },
 }
 

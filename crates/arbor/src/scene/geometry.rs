@@ -51,8 +51,9 @@ pub struct SceneObject {
     pub shape: Shape,
     /// Object to world for meshes (spheres carry theirs); `None` for the identity.
     pub transform: Option<Transform>,
-    /// World-space translation over the shutter interval (zero for a still object).
-    pub motion: Vec3,
+    /// World-space translation over the shutter interval; `None` for a still object (tested once, not
+    /// per ray).
+    pub motion: Option<Vec3>,
     /// World-space bounds over the whole shutter interval.
     pub bounds: Aabb,
     /// Index into the description's objects.
@@ -84,11 +85,10 @@ impl SceneObject {
 /// `ray` seen by an object moving by `motion` over the shutter interval, as if the object stood still
 /// where it is at time 0: the ray moves back by the object's displacement at the ray's time.
 #[inline]
-pub(super) fn still_ray(ray: &Ray, motion: Vec3) -> Ray {
-    if motion == Vec3::ZERO {
-        *ray
-    } else {
-        Ray { origin: ray.origin - ray.time * motion, ..*ray }
+pub(super) fn still_ray(ray: &Ray, motion: Option<Vec3>) -> Ray {
+    match motion {
+        None => *ray,
+        Some(m) => Ray { origin: ray.origin - ray.time * m, ..*ray },
     }
 }
 
@@ -99,8 +99,8 @@ pub struct ScenePlane {
     pub plane: Plane,
     /// Index into the description's objects.
     pub object: u32,
-    /// World-space translation over the shutter interval.
-    pub motion: Vec3,
+    /// World-space translation over the shutter interval; `None` for a still plane.
+    pub motion: Option<Vec3>,
 }
 
 impl ScenePlane {
@@ -352,8 +352,7 @@ impl SceneGeometry {
 
     /// Whether anything moves over the shutter interval.
     pub fn has_motion(&self) -> bool {
-        self.objects.objects.iter().any(|o| o.motion != Vec3::ZERO)
-            || self.planes.iter().any(|p| p.motion != Vec3::ZERO)
+        self.objects.objects.iter().any(|o| o.motion.is_some()) || self.planes.iter().any(|p| p.motion.is_some())
     }
 
     /// Bounds of the bounded objects.

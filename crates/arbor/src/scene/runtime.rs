@@ -104,7 +104,7 @@ impl Scene {
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
                 // Where a moving object is at the ray's time; shapes below are placed at time 0.
-                let shift = o.motion * ray.time;
+                let shift = o.motion.map_or(Vec3::ZERO, |m| m * ray.time);
                 let (ng, ns) = match &o.shape {
                     Shape::Mesh(m) => {
                         if bound {
@@ -144,7 +144,7 @@ impl Scene {
             None => {
                 let ScenePlane { plane, object, motion } = g.planes[hit.prim as usize - g.objects.objects.len()];
                 if bound {
-                    let shift = motion * ray.time;
+                    let shift = motion.map_or(Vec3::ZERO, |m| m * ray.time);
                     (p, p_error) = plane_point(p - shift, plane.point, plane.normal);
                     p += shift;
                 }
@@ -176,7 +176,7 @@ impl Scene {
 
     /// The object-space sampling point of a hit and the object's transform (`None` for the identity).
     fn tex_point(&self, ray: &Ray, hit: &Hit, s: &Surface) -> (TexPoint, Option<Transform>) {
-        let still = |motion: Vec3| s.p - motion * ray.time;
+        let still = |motion: Option<Vec3>| motion.map_or(s.p, |m| s.p - m * ray.time);
         match self.geometry.objects.objects.get(hit.prim as usize) {
             Some(o) => match &o.shape {
                 Shape::Mesh(m) => {

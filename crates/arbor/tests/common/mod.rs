@@ -62,3 +62,17 @@ pub fn missing_mesh_files(desc: &SceneDesc) -> Vec<PathBuf> {
         })
         .collect()
 }
+
+/// The image files a METU XML scene names (`Textures/Images/Image`, `EnvMapName`) that are not there,
+/// relative to the scene's folder.
+pub fn missing_image_files(scene: &Path) -> Vec<PathBuf> {
+    let Ok(text) = std::fs::read_to_string(scene) else { return Vec::new() };
+    let Ok(doc) = roxmltree::Document::parse(&text) else { return Vec::new() };
+    let dir = scene.parent().unwrap_or(Path::new("."));
+    doc.descendants()
+        .filter(|n| n.has_tag_name("Image") || n.has_tag_name("EnvMapName"))
+        .filter_map(|n| n.text().map(str::trim).filter(|t| !t.is_empty()))
+        .map(|t| dir.join(t))
+        .filter(|p| !p.is_file())
+        .collect()
+}

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 
 use super::tree::{Node, Unused};
 use crate::math::{Mat4, Transform, Vec2, Vec3};
-use crate::scene::desc::{LightDesc, SceneDesc};
+use crate::scene::desc::SceneDesc;
 use crate::{Error, Location, Result};
 
 /// Which form of the schema a file is written in.
@@ -303,78 +303,6 @@ impl Reader<'_> {
         Ok(acc)
     }
 
-    fn lights(&mut self, l: &Node) -> Result<()> {
-        let p = self.path;
-        if let Some(a) = self.one(l, "AmbientLight") {
-            self.desc.ambient = a.vec3(p)?;
-        }
-        for n in &l.children {
-            let light = match n.name.as_str() {
-                "PointLight" => LightDesc::Point {
-                    position: self.req(n, "Position")?.vec3(p)?,
-                    intensity: self.req(n, "Intensity")?.vec3(p)?,
-                },
-                "AreaLight" => self.area_light(n)?,
-                "DirectionalLight" => LightDesc::Directional {
-                    direction: self.unit(n, "Direction")?,
-                    radiance: self.req(n, "Radiance")?.vec3(p)?,
-                },
-                "SphericalDirectionalLight" => {
-                    // Before 2022 the light names its file (`EnvMapName`); from 2022 on an image
-                    // of `Textures/Images` (`ImageId`).
-                    let (name_node, name) = match (self.one(n, "EnvMapName"), self.one(n, "ImageId")) {
-                        (Some(e), _) => (e, e.trimmed().to_string()),
-                        (None, Some(i)) => {
-                            let id = i.trimmed();
-                            let file = self.images.get(id).ok_or_else(|| {
-                                self.err(i, format!("<ImageId>: no <Image id=\"{id}\"> in <Textures><Images>"))
-                            })?;
-                            (i, file.clone())
-                        }
-                        (None, None) => {
-                            let msg = "<SphericalDirectionalLight>: missing <EnvMapName> or <ImageId>";
-                            return Err(self.err(n, msg));
-                        }
-                    };
-                    self.desc.environment_loc = Some(name_node.loc(p));
-                    if self.desc.environment.is_some() {
-                        let msg = "duplicate environment light; the last one wins".to_string();
-                        self.notes.plain(n.loc(p), msg);
-                    }
-                    self.desc.environment = Some(self.dir.join(name));
-                    n.mark_used();
-                    n.attr("id");
-                    continue;
-                }
-                _ => continue,
-            };
-            n.mark_used();
-            n.attr("id");
-            self.desc.lights.push(light);
-        }
-        self.unsupported(l, "SpotLight", "spot lights are");
-        Ok(())
-    }
-
-    /// An `AreaLight`: a square of positive side whose area is a finite number, facing a non-zero
-    /// normal (the number reader already refuses non-finite coordinates and radiance).
-    fn area_light(&mut self, n: &Node) -> Result<LightDesc> {
-        let p = self.path;
-        let position = self.req(n, "Position")?.vec3(p)?;
-        let normal = self.unit(n, "Normal")?;
-        let s = self.req(n, "Size")?;
-        let size = s.float(p)?;
-        let name = || format!("AreaLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));
-        if size <= 0.0 {
-            return Err(self.err(s, format!("{}: Size {size} must be positive", name())));
-        }
-        if !(size * size).is_finite() {
-            return Err(self.err(s, format!("{}: Size {size} is too large (its area is not a finite number)", name())));
-        }
-        let radiance = self.req(n, "Radiance")?.vec3(p)?;
-        Ok(LightDesc::Area { position, normal, size, radiance })
-    }
-
     /// The child `name` of `n` as a unit vector.
     fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
         let c = self.req(n, name)?;
@@ -384,6 +312,7 @@ impl Reader<'_> {
 }
 
 mod camera;
+mod lights;
 mod material;
 mod objects;
 mod textures;
@@ -391,7 +320,7 @@ mod textures;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::desc::{Lens, MaterialKind, ShapeDesc};
+    use crate::scene::desc::{Lens, LightDesc, MaterialKind, ShapeDesc};
     use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
@@ -621,6 +550,11 @@ mod tests {
         let by_name = "<Lights><SphericalDirectionalLight id=\"1\"><EnvMapName>env.hdr</EnvMapName>\
                        </SphericalDirectionalLight></Lights>";
         assert_eq!(read_xml(by_name).unwrap().environment, Some(PathBuf::from("env.hdr")));
+        assert!(!read_xml(by_name).unwrap().environment_probe);
+        let probe = by_name.replace("id=\"1\">", "id=\"1\" type=\"probe\">");
+        assert!(read_xml(&probe).unwrap().environment_probe);
+        let e = read_xml(&probe.replace("probe", "cube")).unwrap_err();
+        assert!(e.to_string().ends_with("unknown type 'cube' (expected latlong or probe)"), "{e}");
         let missing = by_id.replace(">2<", ">3<");
         let e = read_xml(&missing).unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:144: <ImageId>: no <Image id=\"3\"> in <Textures><Images>");

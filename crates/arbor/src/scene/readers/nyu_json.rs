@@ -106,6 +106,7 @@ fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,
+        tonemap: None,
         loc: c.loc(at),
     })
 }

@@ -5,6 +5,7 @@
 use super::Reader;
 use crate::scene::desc::{CameraDesc, Lens, Window};
 use crate::scene::readers::tree::Node;
+use crate::tonemap::{Operator, Tonemap};
 use crate::{Error, Result};
 
 impl Reader<'_> {
@@ -72,7 +73,10 @@ impl Reader<'_> {
             (None, Some(_)) => return Err(self.err(c, "<Camera>: missing <FocusDistance>")),
         };
         let transform = self.transform_of(c)?;
-        self.unsupported(c, "Tonemap", "tone mapping is");
+        let tonemap = match self.one(c, "Tonemap") {
+            Some(t) => Some(self.tonemap(t, &id)?),
+            None => None,
+        };
         self.unsupported(c, "Renderer", "path tracing is");
         self.unsupported(c, "RendererParams", "path tracing is");
         Ok(CameraDesc {
@@ -89,6 +93,7 @@ impl Reader<'_> {
             num_samples,
             transform,
             lens,
+            tonemap,
             loc: c.loc(p),
         })
     }
@@ -112,6 +117,50 @@ impl Reader<'_> {
             self.notes.plain(n.loc(p), msg);
         }
         Ok(square)
+    }
+
+    /// A `Tonemap` (hw5): `TMO` (only `Photographic`), `TMOOptions` (key value and burn-out percentage),
+    /// `Saturation` (default 1) and `Gamma` (default 2.2). The key must be positive (0 maps every pixel to
+    /// black), the burn-out a percentage, the saturation not negative and the gamma positive.
+    fn tonemap(&mut self, t: &Node, id: &str) -> Result<Tonemap> {
+        let p = self.path;
+        let tmo = self.req(t, "TMO")?;
+        let operator = match tmo.trimmed() {
+            "Photographic" => Operator::Photographic,
+            other => {
+                let msg = format!("Camera {id}: unknown TMO '{other}' (expected Photographic)");
+                return Err(self.err(tmo, msg));
+            }
+        };
+        let options = self.req(t, "TMOOptions")?;
+        let v = options.floats_n(2, false, p)?;
+        let (key, burn_percent) = (v[0], v[1]);
+        if key <= 0.0 {
+            return Err(self.err(options, format!("Camera {id}: TMOOptions key value {key} must be positive")));
+        }
+        if !(0.0..=100.0).contains(&burn_percent) {
+            let msg = format!("Camera {id}: TMOOptions burn-out percentage {burn_percent} must be in [0, 100]");
+            return Err(self.err(options, msg));
+        }
+        let saturation_node = self.one(t, "Saturation");
+        let saturation = match saturation_node {
+            Some(s) => s.float(p)?,
+            None => 1.0,
+        };
+        if saturation < 0.0 {
+            let msg = format!("Camera {id}: Saturation {saturation} must not be negative");
+            return Err(self.err(saturation_node.unwrap_or(t), msg));
+        }
+        let gamma_node = self.one(t, "Gamma");
+        let gamma = match gamma_node {
+            Some(g) => g.float(p)?,
+            None => 2.2,
+        };
+        if gamma <= 0.0 {
+            return Err(self.err(gamma_node.unwrap_or(t), format!("Camera {id}: Gamma {gamma} must be positive")));
+        }
+        t.mark_used();
+        Ok(Tonemap { operator, key, burn_percent, saturation, gamma })
     }
 
     /// The thin lens of `FocusDistance` `f` and `ApertureSize` `a`; none (a pinhole) when the aperture
