@@ -81,7 +81,7 @@ mod tests {
     use crate::Location;
 
     fn map(image: usize, interpolation: Interpolation) -> TextureDesc {
-        let source = TextureSource::Image { image, interpolation, normalizer: 255.0, degamma: false, clamp: false };
+        let source = TextureSource::Image { image, interpolation, normalizer: 255.0, clamp: false };
         TextureDesc {
             id: "1".into(),
             source,

@@ -64,8 +64,6 @@ pub enum TextureSource {
         interpolation: Interpolation,
         /// Texel values are divided by this (255 for 8-bit images), positive.
         normalizer: f32,
-        /// Whether 8-bit texels are sRGB-encoded and linearised before use.
-        degamma: bool,
         /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
         clamp: bool,
     },

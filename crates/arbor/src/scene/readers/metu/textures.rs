@@ -84,7 +84,7 @@ impl Reader<'_> {
                 };
                 let image = self.desc.images.len();
                 self.desc.images.push(ImageDesc { path: self.dir.join(path), loc: file.loc(p) });
-                TextureSource::Image { image, interpolation, normalizer, degamma: false, clamp }
+                TextureSource::Image { image, interpolation, normalizer, clamp }
             }
         };
         let mut maps = vec![self.desc.textures.len()];
@@ -114,13 +114,8 @@ impl Reader<'_> {
     pub(super) fn background_texture(&mut self, n: &Node) {
         let image = self.desc.images.len();
         self.desc.images.push(ImageDesc { path: self.dir.join(n.trimmed()), loc: n.loc(self.path) });
-        let source = TextureSource::Image {
-            image,
-            interpolation: Interpolation::Nearest,
-            normalizer: 255.0,
-            degamma: false,
-            clamp: true,
-        };
+        let source =
+            TextureSource::Image { image, interpolation: Interpolation::Nearest, normalizer: 255.0, clamp: true };
         let decal = DecalMode::ReplaceBackground;
         let t = TextureDesc { id: "background".into(), source, decal, bump_factor: 1.0, loc: n.loc(self.path) };
         self.desc.textures.push(t);
@@ -142,11 +137,7 @@ impl Reader<'_> {
                     self.err(i, format!("{name}: no <Image id=\"{}\"> in <Textures><Images>", i.trimmed()))
                 })?;
                 let (interpolation, normalizer) = self.image_sampling(map, &name)?;
-                let degamma = match map.attr("degamma") {
-                    Some(a) => a.boolean(p)?,
-                    None => false,
-                };
-                TextureSource::Image { image, interpolation, normalizer, degamma, clamp: false }
+                TextureSource::Image { image, interpolation, normalizer, clamp: false }
             }
             "perlin" => {
                 let conversion = match self.one(map, "NoiseConversion").map(|n| (n, n.trimmed())) {
