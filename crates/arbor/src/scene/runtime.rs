@@ -244,3 +244,31 @@ fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
     };
     (ng, ns)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_tex_point_follows_the_course_spherical_coordinates() {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        let at = |d: Vec3| sphere_tex_point(c + 2.0 * d, c, 2.0);
+        // +x: φ = 0, θ = π/2; +z: φ = π/2; the top: θ = 0.
+        assert!(at(Vec3::X).uv.abs_diff_eq(Vec2::new(0.5, 0.5), 1e-6));
+        assert!(at(Vec3::Z).uv.abs_diff_eq(Vec2::new(0.25, 0.5), 1e-6));
+        assert!((at(Vec3::Y).uv.y).abs() < 1e-6);
+        assert!((at(-Vec3::Y).uv.y - 1.0).abs() < 1e-6);
+        // The derivatives follow the point: a small step in u or v moves it by ∂p/∂u or ∂p/∂v times the step.
+        let d = Vec3::new(0.3, 0.4, -0.5).normalize();
+        let p = at(d);
+        let h = 1e-3;
+        let step = |du: f32, dv: f32| {
+            let (u, v) = (p.uv.x + du, p.uv.y + dv);
+            let (phi, theta) = (std::f32::consts::PI - 2.0 * std::f32::consts::PI * u, std::f32::consts::PI * v);
+            c + 2.0 * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        };
+        assert!(((step(h, 0.0) - step(-h, 0.0)) / (2.0 * h)).abs_diff_eq(p.dpdu, 1e-2), "{}", p.dpdu);
+        assert!(((step(0.0, h) - step(0.0, -h)) / (2.0 * h)).abs_diff_eq(p.dpdv, 1e-2), "{}", p.dpdv);
+        assert!(p.n.abs_diff_eq(d, 1e-6));
+    }
+}
