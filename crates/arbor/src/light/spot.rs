@@ -5,7 +5,7 @@
 //! light arrives. (The assignment text prints `cos(falloff/2)` in the numerator, which would make the
 //! light brighten towards the coverage edge, against the text's own description of a diminishing light.)
 
-use super::{Light, LightSample};
+use super::{Light, LightSample, PointLight};
 use crate::math::{Color, Vec2, Vec3};
 
 /// A point light emitting in a cone.
@@ -51,18 +51,11 @@ impl SpotLight {
 }
 
 impl Light for SpotLight {
-    fn sample(&self, p: Vec3, _n: Vec3, _u: Vec2) -> Option<LightSample> {
-        let to_light = self.position - p;
-        let d2 = to_light.length_squared();
-        // Negated so that a NaN distance (a NaN point) gives no light, as a zero one does.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if !(d2 > 0.0) {
-            return None;
-        }
-        let dist = d2.sqrt();
-        let wi = to_light / dist;
-        let s = self.attenuation(-wi);
-        (s > 0.0).then(|| LightSample { wi, dist, irradiance: self.intensity * (s / d2) })
+    fn sample(&self, p: Vec3, n: Vec3, u: Vec2) -> Option<LightSample> {
+        // A point light whose intensity falls off away from the axis.
+        let ls = PointLight { position: self.position, intensity: self.intensity }.sample(p, n, u)?;
+        let s = self.attenuation(-ls.wi);
+        (s > 0.0).then(|| LightSample { irradiance: ls.irradiance * s, ..ls })
     }
 }
 
