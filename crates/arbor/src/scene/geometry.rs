@@ -82,6 +82,12 @@ impl SceneObject {
     }
 }
 
+/// How far an object moving by `motion` over the shutter interval has moved at `time`.
+#[inline]
+pub fn displacement(motion: Option<Vec3>, time: f32) -> Vec3 {
+    motion.map_or(Vec3::ZERO, |m| m * time)
+}
+
 /// `ray` seen by an object moving by `motion` over the shutter interval, as if the object stood still
 /// where it is at time 0: the ray moves back by the object's displacement at the ray's time.
 #[inline]

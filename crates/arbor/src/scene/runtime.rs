@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use super::geometry::{SceneGeometry, ScenePlane, Shape};
+use super::geometry::{displacement, SceneGeometry, ScenePlane, Shape};
 use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
@@ -104,7 +104,7 @@ impl Scene {
         let (ng, ns, object) = match g.objects.objects.get(hit.prim as usize) {
             Some(o) => {
                 // Where a moving object is at the ray's time; shapes below are placed at time 0.
-                let shift = o.motion.map_or(Vec3::ZERO, |m| m * ray.time);
+                let shift = displacement(o.motion, ray.time);
                 let (ng, ns) = match &o.shape {
                     Shape::Mesh(m) => {
                         if bound {
@@ -144,7 +144,7 @@ impl Scene {
             None => {
                 let ScenePlane { plane, object, motion } = g.planes[hit.prim as usize - g.objects.objects.len()];
                 if bound {
-                    let shift = motion.map_or(Vec3::ZERO, |m| m * ray.time);
+                    let shift = displacement(motion, ray.time);
                     (p, p_error) = plane_point(p - shift, plane.point, plane.normal);
                     p += shift;
                 }
@@ -176,7 +176,7 @@ impl Scene {
 
     /// The object-space sampling point of a hit and the object's transform (`None` for the identity).
     fn tex_point(&self, ray: &Ray, hit: &Hit, s: &Surface) -> (TexPoint, Option<Transform>) {
-        let still = |motion: Option<Vec3>| motion.map_or(s.p, |m| s.p - m * ray.time);
+        let still = |motion| s.p - displacement(motion, ray.time);
         match self.geometry.objects.objects.get(hit.prim as usize) {
             Some(o) => match &o.shape {
                 Shape::Mesh(m) => {
