@@ -15,6 +15,7 @@ use arbor::Location;
 
 fn material(ambient: f32, diffuse: f32, kind: MaterialKind) -> MaterialDesc {
     MaterialDesc {
+        degamma: false,
         id: "m".into(),
         ambient: Color::splat(ambient),
         diffuse: Color::splat(diffuse),

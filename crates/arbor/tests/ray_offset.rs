@@ -44,6 +44,7 @@ fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {
     let mut d = SceneDesc::new("offset.xml");
     d.offset = rule;
     d.materials.push(MaterialDesc {
+        degamma: false,
         id: "m".into(),
         ambient: Color::ONE,
         diffuse: Color::ONE,
@@ -191,6 +192,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
         d.shadows = shadows;
         d.radiance_scale = 1.0 / 255.0;
         d.materials.push(MaterialDesc {
+            degamma: false,
             id: "m".into(),
             ambient: Color::ZERO,
             diffuse: Color::splat(1.0),

@@ -38,6 +38,7 @@ fn object(name: &str, shape: ShapeDesc, transform: Transform) -> ObjectDesc {
 fn desc(objects: Vec<ObjectDesc>) -> SceneDesc {
     let mut d = SceneDesc::new("two_level.xml");
     d.materials.push(MaterialDesc {
+        degamma: false,
         id: "1".into(),
         ambient: Color::ONE,
         diffuse: Color::ONE,

@@ -165,6 +165,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
     // A whole scene: the mesh, a sphere and a plane, under every structure.
     let mut desc = SceneDesc::new("bad_rays.xml");
     desc.materials.push(MaterialDesc {
+        degamma: false,
         id: "m".into(),
         ambient: Color::ONE,
         diffuse: Color::ONE,

@@ -97,6 +97,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
     let mut desc = SceneDesc::new(source);
     desc.cameras.push(camera);
     desc.materials.push(MaterialDesc {
+        degamma: false,
         id: "grey".into(),
         ambient: Color::splat(0.1),
         diffuse: Color::splat(0.7),

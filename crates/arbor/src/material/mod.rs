@@ -55,6 +55,10 @@ pub trait SpecularLayer: fmt::Debug + Send + Sync {
     }
 }
 
+/// The exponent that turns a display colour into a linear reflectance for a `degamma` material: the
+/// course's display gamma (its tone mapping writes PNGs with `Gamma` 2.2).
+pub const DEGAMMA: f32 = 2.2;
+
 /// A material ready for shading.
 #[derive(Debug)]
 pub struct Material {

@@ -24,7 +24,7 @@ use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
-use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent};
+use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent, DEGAMMA};
 use crate::math::{Aabb, Vec3};
 use crate::texture::Decal;
 use crate::{Error, Location, Result};
@@ -118,19 +118,22 @@ pub fn build_camera(desc: &CameraDesc) -> Camera {
 
 /// The runtime material of a description.
 fn build_material(desc: &MaterialDesc) -> Material {
+    let linear = |c: crate::math::Color| if desc.degamma { c.powf(DEGAMMA) } else { c };
     let layer: Option<Box<dyn SpecularLayer>> = match desc.kind {
         MaterialKind::BlinnPhong => None,
-        MaterialKind::Mirror { reflectance } => Some(Box::new(Mirror { reflectance })),
-        MaterialKind::Conductor { reflectance, eta, k } => Some(Box::new(Conductor { reflectance, eta, k })),
+        MaterialKind::Mirror { reflectance } => Some(Box::new(Mirror { reflectance: linear(reflectance) })),
+        MaterialKind::Conductor { reflectance, eta, k } => {
+            Some(Box::new(Conductor { reflectance: linear(reflectance), eta, k }))
+        }
         MaterialKind::Dielectric { eta, absorption } => Some(Box::new(Dielectric { eta, absorption })),
         MaterialKind::Transparent { eta, transparency, mirror } => {
             Some(Box::new(Transparent { eta, transparency, mirror }))
         }
     };
     Material {
-        ambient: desc.ambient,
-        diffuse: desc.diffuse,
-        specular: desc.specular,
+        ambient: linear(desc.ambient),
+        diffuse: linear(desc.diffuse),
+        specular: linear(desc.specular),
         phong_exponent: desc.phong_exponent,
         roughness: desc.roughness,
         layer,
@@ -361,6 +364,7 @@ mod tests {
     #[test]
     fn build_material_maps_every_kind() {
         let desc = |kind| MaterialDesc {
+            degamma: false,
             id: "m".into(),
             ambient: Color::splat(0.1),
             diffuse: Color::splat(0.2),
@@ -387,6 +391,15 @@ mod tests {
         assert_eq!(mirror.specular_lobes(d, Vec3::Y)[0].dir, Vec3::Y);
         let metal = build_material(&desc(MaterialKind::Conductor { reflectance: Color::ONE, eta: 0.4, k: 2.8 }));
         assert!(!metal.transmits() && metal.specular_lobes(d, Vec3::Y).len() == 1);
+        // degamma: display colours become linear by the power 2.2 (0.5 -> 0.2176).
+        let shown = MaterialDesc { degamma: true, ..desc(MaterialKind::Mirror { reflectance: Color::splat(0.5) }) };
+        let linear = build_material(&shown);
+        assert!((linear.diffuse.x - 0.2_f32.powf(2.2)).abs() < 1e-6, "{}", linear.diffuse);
+        assert!(
+            (linear.ambient.x - 0.1_f32.powf(2.2)).abs() < 1e-6 && (linear.specular.z - 0.3_f32.powf(2.2)).abs() < 1e-6
+        );
+        let up = linear.specular_lobes(d, Vec3::Y)[0].weight;
+        assert!((up.y - 0.217_637_65).abs() < 1e-6, "{up}");
     }
 
     #[test]

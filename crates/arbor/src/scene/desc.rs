@@ -270,6 +270,9 @@ pub struct MaterialDesc {
     pub roughness: f32,
     /// Mirror, conductor, dielectric...
     pub kind: MaterialKind,
+    /// The colours are display values (`degamma="true"`): the build raises them to the power
+    /// [`DEGAMMA`](crate::material::DEGAMMA) to make them linear reflectances.
+    pub degamma: bool,
 }
 
 /// Where a mesh's triangles come from.

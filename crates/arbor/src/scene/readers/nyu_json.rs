@@ -125,6 +125,7 @@ fn material(m: &Obj<'_>, i: usize, warn: &mut Vec<String>) -> Result<MaterialDes
     let known = ["Ambient", "Diffuse", "Specular", "Shininess", "Mirror", "Refraction", "RefractionIndex"];
     m.unknown(&known, warn);
     Ok(MaterialDesc {
+        degamma: false,
         id: i.to_string(),
         ambient: m.vec3("Ambient")?,
         diffuse: m.vec3("Diffuse")?,

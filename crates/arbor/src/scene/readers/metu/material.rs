@@ -79,13 +79,17 @@ impl Reader<'_> {
                 }
             }
         };
-        for (attr, what) in [("BRDF", "BRDF models are"), ("degamma", "degamma is")] {
-            if let Some(a) = m.attr(attr) {
-                let label = format!("attribute {attr} of <Material>");
-                let msg = format!("{what} not supported; ignored");
-                self.notes.feature(a.loc(p), &label, &msg);
-            }
+        if let Some(a) = m.attr("BRDF") {
+            self.notes.feature(a.loc(p), "attribute BRDF of <Material>", "BRDF models are not supported; ignored");
         }
+        let degamma = match m.attr("degamma").map(|a| (a, a.trimmed())) {
+            None | Some((_, "false")) => false,
+            Some((_, "true")) => true,
+            Some((a, other)) => {
+                let msg = format!("Material {id}: degamma must be true or false, not '{other}'");
+                return Err(Error::input(a.loc(p), msg));
+            }
+        };
         let roughness = match self.one(m, "Roughness") {
             Some(n) => {
                 let r = n.float(p)?;
@@ -96,7 +100,7 @@ impl Reader<'_> {
             }
             None => 0.0,
         };
-        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, roughness, kind })
+        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, roughness, kind, degamma })
     }
 
     /// A legacy opaque material's `RefractionIndex`: it has no effect (only a non-zero `Transparency`
