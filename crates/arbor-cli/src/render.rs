@@ -246,7 +246,10 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                let tonemap = if args.debug.is_some() { None } else { cam.tonemap.as_ref() };
+                // An HDR image always gets its PNG beside it, by the course's tone mapping if the camera
+                // names none; a debug view is written as it is.
+                let preview = arbor::image_io::is_hdr_path(&target).then_some(&arbor::tonemap::Tonemap::PREVIEW);
+                let tonemap = if args.debug.is_some() { None } else { cam.tonemap.as_ref().or(preview) };
                 let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap))?;
                 extra = written.into_iter().filter(|p| *p != target).collect();
                 (target, stats, window)

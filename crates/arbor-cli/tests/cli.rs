@@ -107,6 +107,22 @@ fn cli_hdr_image_with_a_tonemap_gets_a_tone_mapped_png_beside_it() {
 }
 
 #[test]
+fn cli_hdr_image_without_a_tonemap_gets_the_course_tone_mapping_beside_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = write(tmp.path(), "t.xml", &TINY.replace("IMAGE_EXT", "exr"));
+    let o = arbor(&["render", "-q", scene.to_str().unwrap()], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "Saved: ./tiny.exr\nSaved: ./tiny.png\n");
+    let hdr = arbor::image_io::read_image(&tmp.path().join("tiny.exr")).unwrap();
+    let expected = (hdr.width, hdr.height, arbor::tonemap::Tonemap::PREVIEW.apply(&hdr).to_rgb8());
+    assert_eq!(arbor::image_io::read_rgb8(&tmp.path().join("tiny.png")).unwrap(), expected);
+    // A debug view is written as it is, alone.
+    let debug = arbor(&["render", "-q", scene.to_str().unwrap(), "--debug", "normal", "-o", "d"], tmp.path());
+    assert!(debug.status.success(), "{}", stderr(&debug));
+    assert!(!tmp.path().join("d/tiny.png").exists());
+}
+
+#[test]
 fn cli_usage_error_exits_2() {
     let tmp = tempfile::tempdir().unwrap();
     assert_eq!(arbor(&["render", "--spp", "zero"], tmp.path()).status.code(), Some(2));
