@@ -34,8 +34,10 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
         .map(|p| arbor::farm::read_partial(p).map(|part| (p.clone(), part)))
         .collect::<Result<Vec<_>, _>>()?;
     let film = arbor::farm::merge(&parts)?;
+    // Written as the single-process render writes it: the camera's tone mapping, the PNG beside HDR.
+    let tonemap = parts[0].1.tonemap.or_else(|| crate::outputs::hdr_preview(&args.out));
     signals.enter(crate::signals::Stage::Render);
-    signals.writing(|| arbor::image_io::write_image(&args.out, &film))?;
+    let written = signals.writing(|| arbor::image_io::write_outputs(&args.out, &film, tonemap.as_ref()))?;
     signals.check()?;
     if !args.quiet {
         let spp = parts.first().map_or(0, |(_, p)| p.sums.spp);
@@ -48,6 +50,8 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
             start.elapsed().as_secs_f64() * 1e3
         );
     }
-    say!("Saved: {}", args.out.display());
+    for path in written {
+        say!("Saved: {}", path.display());
+    }
     Ok(())
 }

@@ -21,6 +21,7 @@ use arbor::scene::{check_limits, load_desc, parse_desc, Scene, SceneDesc, SceneL
 use clap::Args;
 use serde_json::json;
 
+use crate::outputs::hdr_preview;
 use crate::progress::Progress;
 use crate::signals::{Signals, Stage};
 use crate::slice::{identity, Slice, SliceArgs};
@@ -219,6 +220,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         // The tone-mapped PNG beside a high-dynamic-range image.
         let mut extra = Vec::new();
+        // A debug view is written as it is.
+        let tonemap = if args.debug.is_some() { None } else { cam.tonemap };
         let (path, stats, window) = match &slice {
             Some(s) => {
                 let opts = RenderOptions { crop: s.window(cam)?, samples: Some(s.samples(spp)?), ..base.clone() };
@@ -234,7 +237,9 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 signals.check()?;
-                signals.writing(|| write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), sums }))?;
+                signals.writing(|| {
+                    write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), tonemap, sums })
+                })?;
                 (target, stats, window)
             }
             None => {
@@ -246,11 +251,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                // An HDR image always gets its PNG beside it, by the course's tone mapping if the camera
-                // names none; a debug view is written as it is.
-                let preview = arbor::image_io::is_hdr_path(&target).then_some(&arbor::tonemap::Tonemap::PREVIEW);
-                let tonemap = if args.debug.is_some() { None } else { cam.tonemap.as_ref().or(preview) };
-                let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap))?;
+                let tonemap = if args.debug.is_some() { None } else { tonemap.or_else(|| hdr_preview(&target)) };
+                let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap.as_ref()))?;
                 extra = written.into_iter().filter(|p| *p != target).collect();
                 (target, stats, window)
             }

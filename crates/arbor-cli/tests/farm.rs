@@ -82,7 +82,11 @@ fn farm_cli_tiles_of_the_example_merge_to_the_whole_png() {
 fn farm_cli_cameras_tiles_and_sample_ranges_merge_to_the_whole_exr() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    std::fs::write(d.join("two.xml"), TWO_CAMERAS.replace(".png", ".exr")).unwrap();
+    // The side camera names a tone mapping; the front camera's PNG gets the default one.
+    let tonemap = "<ImageName>side.exr</ImageName><Tonemap><TMO>Photographic</TMO><TMOOptions>0.3 5</TMOOptions>\
+                   <Saturation>0.8</Saturation><Gamma>1.8</Gamma></Tonemap>";
+    let scene = TWO_CAMERAS.replace(".png", ".exr").replace("<ImageName>side.exr</ImageName>", tonemap);
+    std::fs::write(d.join("two.xml"), scene).unwrap();
     ok(&["render", "--quiet", "two.xml", "-o", "whole"], d);
     for cam in ["front", "side"] {
         let mut args = vec!["merge".to_string()];
@@ -97,8 +101,11 @@ fn farm_cli_cameras_tiles_and_sample_ranges_merge_to_the_whole_exr() {
             }
         }
         args.extend(["-o".into(), format!("{cam}.exr")]);
-        ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), d);
+        let said = ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), d);
+        assert!(said.ends_with(&format!("Saved: {cam}.exr\nSaved: {cam}.png\n")), "{said}");
         same_file(&d.join(format!("{cam}.exr")), &d.join(format!("whole/{cam}.exr")));
+        // The tone-mapped PNG beside it, as the single-process render wrote it.
+        same_file(&d.join(format!("{cam}.png")), &d.join(format!("whole/{cam}.png")));
     }
 }
 

@@ -9,6 +9,7 @@ use arbor::farm::{merge, read_partial, tile_window, write_partial, Partial};
 use arbor::film::Film;
 use arbor::render::{render, render_sums, RenderOptions};
 use arbor::scene::{parse_desc, Scene};
+use arbor::tonemap::Tonemap;
 
 fn example() -> Scene {
     let text = include_str!("../../../examples/cornell_box.xml");
@@ -34,7 +35,8 @@ fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)
     assert_eq!(stats.samples, samples);
     let name = format!("part-{:?}-{}-{}.exr", tile.unwrap_or((0, 1)), samples.0, samples.1);
     let path = dir.join(name);
-    let p = Partial { identity: "example".into(), camera: cam.id.clone(), sums };
+    let tonemap = Some(Tonemap { key: 0.3, burn_percent: 2.5, saturation: 0.8, gamma: 1.8, ..Tonemap::PREVIEW });
+    let p = Partial { identity: "example".into(), camera: cam.id.clone(), tonemap, sums };
     write_partial(&path, &p).unwrap();
     let back = read_partial(&path).unwrap();
     assert_eq!(back, p, "{}", path.display());

@@ -8,7 +8,9 @@
 //! - Header attributes: `arbor.render` (identity of the render: scene, camera and the options that
 //!   change pixels), `arbor.camera`, `arbor.spp` (samples per pixel of the full image),
 //!   `arbor.sampleStart` and `arbor.sampleEnd` (the samples held, `start..end`), `arbor.scale` (radiance
-//!   scale applied at the end).
+//!   scale applied at the end), and for a camera with a tone mapping `arbor.tonemap` (the operator) with
+//!   `arbor.tonemapKey`, `arbor.tonemapBurn`, `arbor.tonemapSaturation` and `arbor.tonemapGamma`, so that
+//!   the merged image is written as the single-process render writes it.
 //!
 //! Written atomically like every image; read back with every field checked, errors naming the file.
 
@@ -20,6 +22,7 @@ use exr::prelude::*;
 use crate::accum::SampleSum;
 use crate::error::{Error, Location, Result};
 use crate::render::RenderSums;
+use crate::tonemap::{Operator, Tonemap};
 
 /// A partial image: the sums of one slice and where they belong.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,11 +31,15 @@ pub struct Partial {
     pub identity: String,
     /// The camera's id (informative; part of the identity).
     pub camera: String,
+    /// The camera's tone mapping, applied when the merged image is written.
+    pub tonemap: Option<Tonemap>,
     /// Frame, window, sample range, scale and the sums.
     pub sums: RenderSums,
 }
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
+const TONEMAP_FIELDS: [&str; 4] =
+    ["arbor.tonemapKey", "arbor.tonemapBurn", "arbor.tonemapSaturation", "arbor.tonemapGamma"];
 
 /// Writes `part` to `path` (atomically: a temporary file renamed over the target).
 pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
@@ -57,6 +64,13 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
     attrs.other.insert(Text::from("arbor.sampleStart"), AttributeValue::I32(s.samples.0 as i32));
     attrs.other.insert(Text::from("arbor.sampleEnd"), AttributeValue::I32(s.samples.1 as i32));
     attrs.other.insert(Text::from("arbor.scale"), AttributeValue::F32(s.scale));
+    if let Some(t) = &part.tonemap {
+        let Operator::Photographic = t.operator;
+        attrs.other.insert(Text::from("arbor.tonemap"), text("Photographic"));
+        for (key, v) in TONEMAP_FIELDS.iter().zip([t.key, t.burn_percent, t.saturation, t.gamma]) {
+            attrs.other.insert(Text::from(*key), AttributeValue::F32(v));
+        }
+    }
     let size = ((x1 - x0) as usize, (y1 - y0) as usize);
     let layer = Layer::new(size, attrs, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
     let mut image = Image::from_layer(layer);
@@ -102,6 +116,19 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
         Some(AttributeValue::F32(v)) => *v,
         _ => return Err(bad("attribute arbor.scale is missing or not a float".into())),
     };
+    let float = |k: &str| match a.get(&Text::from(k)) {
+        Some(AttributeValue::F32(v)) if v.is_finite() => Ok(*v),
+        _ => Err(bad(format!("attribute {k} is missing or not a finite float"))),
+    };
+    let tonemap = match text("arbor.tonemap").as_deref() {
+        None => None,
+        Some("Photographic") => {
+            let [key, burn_percent, saturation, gamma] = [0, 1, 2, 3].map(|i| float(TONEMAP_FIELDS[i]));
+            let (key, burn_percent, saturation, gamma) = (key?, burn_percent?, saturation?, gamma?);
+            Some(Tonemap { operator: Operator::Photographic, key, burn_percent, saturation, gamma })
+        }
+        Some(other) => return Err(bad(format!("unknown tone mapping operator '{other}' in arbor.tonemap"))),
+    };
     let dw = image.attributes.display_window;
     let (pos, size) = (layer.attributes.layer_position, layer.size);
     let frame = (dw.size.0 as u32, dw.size.1 as u32);
@@ -132,5 +159,5 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
         }
     }
     let sums = RenderSums { frame, window, spp, samples: (k0, k1), scale, sums };
-    Ok(Partial { identity, camera, sums })
+    Ok(Partial { identity, camera, tonemap, sums })
 }
