@@ -393,3 +393,45 @@ fn readers_shared_xml_and_json_twins_agree() {
     }
     assert_eq!(compared, 18);
 }
+
+#[test]
+fn readers_left_handed_camera_sees_the_mirror_image() {
+    use arbor::accel::AccelConfig;
+    use arbor::render::{render, RenderOptions};
+    use arbor::scene::{parse_desc, Scene};
+    // An off-centre sphere and a light to its side: the image is not symmetric.
+    let scene = |handedness: &str| {
+        format!(
+            r#"<Scene><Cameras><Camera id="1" type="lookAt" {handedness}><Position>0 0 5</Position>
+            <GazePoint>0 0 0</GazePoint><Up>0 1 0</Up><FovY>40</FovY><NearDistance>1</NearDistance>
+            <ImageResolution>24 16</ImageResolution><ImageName>a.png</ImageName></Camera></Cameras>
+            <Lights><AmbientLight>20 20 20</AmbientLight><PointLight id="1"><Position>3 2 4</Position>
+            <Intensity>500 500 500</Intensity></PointLight></Lights>
+            <Materials><Material id="1"><AmbientReflectance>1 1 1</AmbientReflectance>
+            <DiffuseReflectance>1 0.5 0.2</DiffuseReflectance></Material></Materials>
+            <VertexData>0.7 0.2 0</VertexData>
+            <Objects><Sphere id="1"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere></Objects>
+            </Scene>"#
+        )
+    };
+    let film = |handedness: &str| {
+        let desc = parse_desc(&scene(handedness), Path::new("t.xml")).unwrap();
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap();
+        render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0
+    };
+    let (right, left, default) = (film(r#"handedness="right""#), film(r#"handedness="left""#), film(""));
+    assert_eq!(right.pixels, default.pixels);
+    let (w, h) = (right.width as usize, right.height as usize);
+    let mut off = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let (a, b) = (left.pixels[y * w + x], right.pixels[y * w + (w - 1 - x)]);
+            off += usize::from((a - b).abs().max_element() > 1e-3 * b.max_element().max(1.0));
+        }
+    }
+    assert_eq!(off, 0, "the left-handed image is the right-handed one mirrored left to right");
+    assert_ne!(left.pixels, right.pixels);
+    let e = load_err("t.xml", &scene(r#"handedness="up""#));
+    assert_eq!(e, "t.xml:1:46: Camera 1: handedness must be right or left, not 'up'");
+}

@@ -21,10 +21,14 @@ impl Reader<'_> {
                 return Err(Error::input(a.loc(p), msg));
             }
         };
-        if let Some(h) = c.attr("handedness").filter(|h| h.trimmed() != "right") {
-            let msg = format!("Camera {id}: handedness '{}' not supported; right-handed used", h.trimmed());
-            self.notes.plain(h.loc(p), msg);
-        }
+        let left_handed = match c.attr("handedness").map(|h| (h, h.trimmed())) {
+            None | Some((_, "right")) => false,
+            Some((_, "left")) => true,
+            Some((h, other)) => {
+                let msg = format!("Camera {id}: handedness must be right or left, not '{other}'");
+                return Err(Error::input(h.loc(p), msg));
+            }
+        };
         let position = self.req(c, "Position")?.vec3(p)?;
         let up = self.req(c, "Up")?.vec3(p)?;
         let near_distance = self.req(c, "NearDistance")?.float(p)?;
@@ -66,6 +70,9 @@ impl Reader<'_> {
         if gaze.length_squared() == 0.0 {
             return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
         }
+        // A left-handed camera's u is gaze x up instead of up x gaze: the same camera with its image-plane
+        // window mirrored along u.
+        let window = if left_handed { Window { left: -window.left, right: -window.right, ..window } } else { window };
         let lens = match (self.one(c, "FocusDistance"), self.one(c, "ApertureSize")) {
             (None, None) => None,
             (Some(f), Some(a)) => self.lens(f, a, &id)?,
