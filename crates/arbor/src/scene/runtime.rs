@@ -14,7 +14,7 @@ use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Color, Ray, Transform, Vec2, Vec3};
+use crate::math::{Color, Mat3, Ray, Transform, Vec2, Vec3};
 use crate::texture::{self, Shaded, TexPoint, Texture};
 
 /// A scene ready to render.
@@ -198,18 +198,35 @@ impl Scene {
                         }
                         None => (Vec2::ZERO, Vec3::ZERO, Vec3::ZERO),
                     };
-                    (TexPoint { uv, p, n, dpdu, dpdv }, o.transform)
+                    (TexPoint { uv, p, n, dpdu, dpdv, solid: p, solid_from_p: Mat3::IDENTITY }, o.transform)
                 }
                 Shape::Sphere(sp) => {
                     let t = (!sp.transform.is_identity()).then_some(sp.transform);
-                    let local = t.map_or(still(o.motion), |t| t.inv.transform_point3(still(o.motion)));
-                    (sphere_tex_point(local, sp.center, sp.radius), t)
+                    let world = still(o.motion);
+                    let local = t.map_or(world, |t| t.inv.transform_point3(world));
+                    // A sphere's noise is read at its world-space point, a mesh's at its object-space one:
+                    // so the course's renderer textures them (hw4 ellipsoids_texture, cube_perlin).
+                    let at = TexPoint {
+                        solid: world,
+                        solid_from_p: t.map_or(Mat3::IDENTITY, |t| Mat3::from_mat4(t.m)),
+                        ..sphere_tex_point(local, sp.center, sp.radius)
+                    };
+                    (at, t)
                 }
             },
             None => {
                 let plane = &self.geometry.planes[hit.prim as usize - self.geometry.objects.objects.len()];
                 let (p, n) = (still(plane.motion), plane.plane.normal);
-                (TexPoint { uv: Vec2::ZERO, p, n, dpdu: Vec3::ZERO, dpdv: Vec3::ZERO }, None)
+                let at = TexPoint {
+                    uv: Vec2::ZERO,
+                    p,
+                    n,
+                    dpdu: Vec3::ZERO,
+                    dpdv: Vec3::ZERO,
+                    solid: p,
+                    solid_from_p: Mat3::IDENTITY,
+                };
+                (at, None)
             }
         }
     }
@@ -225,7 +242,7 @@ fn sphere_tex_point(p: Vec3, center: Vec3, radius: f32) -> TexPoint {
     let uv = Vec2::new((PI - phi) / (2.0 * PI), theta / PI);
     let dpdu = 2.0 * PI * Vec3::new(r.z, 0.0, -r.x);
     let dpdv = PI * Vec3::new(r.y * phi.cos(), -radius * theta.sin(), r.y * phi.sin());
-    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv }
+    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv, solid: p, solid_from_p: Mat3::IDENTITY }
 }
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal

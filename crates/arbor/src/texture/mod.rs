@@ -9,7 +9,7 @@ pub mod perlin;
 
 use std::sync::Arc;
 
-use crate::math::{Color, Vec2, Vec3};
+use crate::math::{Color, Mat3, Vec2, Vec3};
 
 pub use checker::Checkerboard;
 pub use image::TexImage;
@@ -47,7 +47,7 @@ pub enum Source {
         /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
         clamp: bool,
     },
-    /// Perlin noise at the object-space point times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
+    /// Perlin noise at the point [`TexPoint::solid`] times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
     Perlin {
         /// `|n|` (else linear).
         absval: bool,
@@ -70,7 +70,8 @@ pub struct Texture {
 }
 
 /// Where a surface is sampled, in object space: texture coordinates, the point, the shading normal and
-/// the derivatives of the point along u and v.
+/// the derivatives of the point along u and v; and the point Perlin noise reads, which is not always
+/// the object-space one.
 #[derive(Debug, Clone, Copy)]
 pub struct TexPoint {
     /// Texture coordinates.
@@ -83,6 +84,12 @@ pub struct TexPoint {
     pub dpdu: Vec3,
     /// ∂p/∂v.
     pub dpdv: Vec3,
+    /// The point Perlin noise reads: the object-space point of a mesh or plane, the world-space point
+    /// (at time 0) of a sphere, as the course's reference images have it.
+    pub solid: Vec3,
+    /// ∂solid/∂p: the linear part of the map from `p` to `solid` (identity when they are the same), to
+    /// bring the noise's gradient back to object space.
+    pub solid_from_p: Mat3,
 }
 
 impl Texture {
@@ -94,7 +101,7 @@ impl Texture {
                 let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
                 c / *normalizer
             }
-            Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.p * *scale), *absval)),
+            Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.solid * *scale), *absval)),
             Source::Checker(c) => c.eval(at.p),
         }
     }
@@ -102,7 +109,8 @@ impl Texture {
     /// The value at texture coordinates `uv` alone (a background): procedural textures see the point
     /// (u, v, 0).
     pub fn eval_uv(&self, uv: Vec2) -> Color {
-        let at = TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y };
+        let p = uv.extend(0.0);
+        let at = TexPoint { uv, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: p, solid_from_p: Mat3::IDENTITY };
         self.eval(&at)
     }
 
@@ -134,10 +142,11 @@ impl Texture {
                 }
             }
             Source::Perlin { absval, scale } => {
-                let q = at.p * *scale;
+                let q = at.solid * *scale;
                 let nv = perlin::noise(q);
                 let slope = if *absval { nv.signum() } else { 0.5 };
-                let g = perlin::gradient(q) * (slope * *scale * k);
+                // The chain rule through p -> solid: the object-space gradient is Jᵀ times the noise's.
+                let g = at.solid_from_p.transpose() * perlin::gradient(q) * (slope * *scale * k);
                 (n - (g - g.dot(n) * n)).normalize_or(n)
             }
             Source::Checker(_) => n,
@@ -204,7 +213,8 @@ mod tests {
 
     /// The plane z = 0 with (u, v) = (x, y).
     fn plane_point(uv: Vec2) -> TexPoint {
-        TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y }
+        let p = uv.extend(0.0);
+        TexPoint { uv, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: p, solid_from_p: Mat3::IDENTITY }
     }
 
     #[test]
@@ -242,5 +252,28 @@ mod tests {
         // A tangent-space normal of (1, 0.5, 0.6) after mapping [0, 1] to [-1, 1]: (1, 0, 0.2).
         let normal = apply([&image_texture(Decal::ReplaceNormal, 1.0, img())], base, &at);
         assert!(normal.n.abs_diff_eq(Vec3::new(1.0, -1.0, -0.6).normalize(), 1e-6), "{}", normal.n);
+    }
+
+    #[test]
+    fn perlin_bump_follows_the_noise_through_the_solid_map() {
+        // A point whose noise is read at solid = M p (a sphere under a transform): the bumped normal must
+        // tilt against the slope of p -> noise(scale · M p), which differs from the slope in solid space.
+        let m = Mat3::from_cols(Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.5, 3.0));
+        let scale = 0.7;
+        let t = Texture { source: Source::Perlin { absval: false, scale }, decal: Decal::BumpNormal, bump_factor: 2.0 };
+        let p = Vec3::new(0.41, 1.37, 0.2);
+        let at =
+            TexPoint { uv: Vec2::ZERO, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: m * p, solid_from_p: m };
+        let base =
+            Shaded { ambient: Color::ONE, diffuse: Color::ONE, specular: Color::ONE, n: Vec3::Z, replace_all: None };
+        let out = apply([&t], base, &at);
+        // The height is 2 · (noise + 1) / 2 = noise(0.7 M p): its x and y slopes by differences in p.
+        let h = 1e-3;
+        let height = |q: Vec3| perlin::noise(m * q * scale);
+        let dx = (height(p + Vec3::X * h) - height(p - Vec3::X * h)) / (2.0 * h);
+        let dy = (height(p + Vec3::Y * h) - height(p - Vec3::Y * h)) / (2.0 * h);
+        let want = Vec3::new(-dx, -dy, 1.0).normalize();
+        assert!(out.n.abs_diff_eq(want, 2e-2), "{} vs {want}", out.n);
+        assert!(dx.abs() + dy.abs() > 0.1, "the point should have a slope");
     }
 }
