@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use super::geometry::{displacement, SceneGeometry, ScenePlane, Shape};
 use crate::accel::Hit;
-use crate::camera::Camera;
+use crate::camera::{Camera, RayCone};
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
@@ -157,10 +157,15 @@ impl Scene {
 
 impl Scene {
     /// The Blinn-Phong terms of `s` after its object's textures, with `s.ns` replaced by the textured
-    /// normal (in world space); `None`, and `s` unchanged, for an object without textures.
-    pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface) -> Option<Shaded> {
+    /// normal (in world space); `None`, and `s` unchanged, for an object without textures. `cone` is the
+    /// ray's, for the footprint that trilinear maps filter over.
+    pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface, cone: RayCone) -> Option<Shaded> {
         let maps = self.object_textures.get(s.object as usize).filter(|t| !t.is_empty())?;
-        let (at, to_world) = self.tex_point(ray, hit, s);
+        let (mut at, to_world) = self.tex_point(ray, hit, s);
+        if maps.iter().any(|&i| self.textures[i].wants_footprint()) {
+            let width = cone.width_at(hit.t * ray.dir.length());
+            at.footprint = footprint(width, ray.dir, s.ng, &at, to_world.as_ref());
+        }
         let m = self.material(s);
         let base = Shaded { ambient: m.ambient, diffuse: m.diffuse, specular: m.specular, n: at.n, replace_all: None };
         let out = texture::apply(maps.iter().map(|&i| &self.textures[i]), base, &at);
@@ -198,7 +203,7 @@ impl Scene {
                         }
                         None => (Vec2::ZERO, Vec3::ZERO, Vec3::ZERO),
                     };
-                    (TexPoint { uv, p, n, dpdu, dpdv }, o.transform)
+                    (TexPoint { uv, p, n, dpdu, dpdv, footprint: 0.0 }, o.transform)
                 }
                 Shape::Sphere(sp) => {
                     let t = (!sp.transform.is_identity()).then_some(sp.transform);
@@ -209,7 +214,7 @@ impl Scene {
             None => {
                 let plane = &self.geometry.planes[hit.prim as usize - self.geometry.objects.objects.len()];
                 let (p, n) = (still(plane.motion), plane.plane.normal);
-                (TexPoint { uv: Vec2::ZERO, p, n, dpdu: Vec3::ZERO, dpdv: Vec3::ZERO }, None)
+                (TexPoint { uv: Vec2::ZERO, p, n, dpdu: Vec3::ZERO, dpdv: Vec3::ZERO, footprint: 0.0 }, None)
             }
         }
     }
@@ -225,7 +230,26 @@ fn sphere_tex_point(p: Vec3, center: Vec3, radius: f32) -> TexPoint {
     let uv = Vec2::new((PI - phi) / (2.0 * PI), theta / PI);
     let dpdu = 2.0 * PI * Vec3::new(r.z, 0.0, -r.x);
     let dpdv = PI * Vec3::new(r.y * phi.cos(), -radius * theta.sin(), r.y * phi.sin());
-    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv }
+    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv, footprint: 0.0 }
+}
+
+/// The side in (u, v) units of a ray cone `width` wide meeting a surface of unit normal `ng` along `dir`
+/// at `at` (Akenine-Möller et al. 2019): the cone's width over `|cos θ|`, times the surface's texel
+/// density `1 / sqrt(|∂p/∂u × ∂p/∂v|)` in world space (for a triangle, the square root of its (u, v)
+/// area over its world area). 0, the finest level, where the derivatives are not known (no (u, v),
+/// a sphere's poles); at grazing angles, past every level.
+fn footprint(width: f32, dir: Vec3, ng: Vec3, at: &TexPoint, to_world: Option<&Transform>) -> f32 {
+    let (du, dv) = match to_world {
+        Some(t) => (t.vector(at.dpdu), t.vector(at.dpdv)),
+        None => (at.dpdu, at.dpdv),
+    };
+    let area = du.cross(dv).length();
+    if area > 0.0 {
+        let cos = dir.normalize_or_zero().dot(ng).abs();
+        width / (cos * area.sqrt())
+    } else {
+        0.0
+    }
 }
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal
@@ -248,6 +272,30 @@ fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn footprint_is_the_cone_width_in_uv_units_stretched_by_the_angle() {
+        // A plane with u = x / 4, v = y / 2 (∂p/∂u = 4x, ∂p/∂v = 2y): sqrt(8) world units per (u, v) unit.
+        let at = TexPoint {
+            uv: Vec2::ZERO,
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            dpdu: 4.0 * Vec3::X,
+            dpdv: 2.0 * Vec3::Y,
+            footprint: 0.0,
+        };
+        let f = footprint(0.5, -Vec3::Z, Vec3::Z, &at, None);
+        assert!((f - 0.5 / 8f32.sqrt()).abs() < 1e-6, "{f}");
+        // At 60° from the normal the cone's section is twice as long.
+        let dir = Vec3::new(3f32.sqrt() / 2.0, 0.0, -0.5) * 3.0;
+        assert!((footprint(0.5, dir, Vec3::Z, &at, None) - 2.0 * f).abs() < 1e-6);
+        // Scaled up twice by its transform, the plane holds four times the area per (u, v) unit.
+        let t = Transform::scale(Vec3::splat(2.0)).unwrap();
+        assert!((footprint(0.5, -Vec3::Z, Vec3::Z, &at, Some(&t)) - f / 2.0).abs() < 1e-6);
+        // No derivatives: the finest level.
+        let flat = TexPoint { dpdu: Vec3::ZERO, ..at };
+        assert_eq!(footprint(0.5, -Vec3::Z, Vec3::Z, &flat, None), 0.0);
+    }
 
     #[test]
     fn sphere_tex_point_follows_the_course_spherical_coordinates() {

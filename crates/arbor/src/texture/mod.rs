@@ -1,10 +1,12 @@
-//! Textures at render time (CENG 795 2022 hw4): image textures ([`TexImage`]), Perlin noise ([`perlin`])
-//! and a 3D checkerboard ([`Checkerboard`]), each with the decal mode that says what its value replaces;
-//! [`apply`] applies an object's textures to its shading terms and normal, in one place. The build step
-//! makes them from the description; nothing here knows the scene file.
+//! Textures at render time (CENG 795 2022 hw4): image textures ([`TexImage`], nearest, bilinear or
+//! trilinear over a mipmap), Perlin noise ([`perlin`]) and a 3D checkerboard ([`Checkerboard`]), each
+//! with the decal mode that says what its value replaces; [`apply`] applies an object's textures to its
+//! shading terms and normal, in one place. The build step makes them from the description; nothing here
+//! knows the scene file.
 
 mod checker;
 mod image;
+mod mipmap;
 pub mod perlin;
 
 use std::sync::Arc;
@@ -33,6 +35,18 @@ pub enum Decal {
     BumpNormal,
 }
 
+/// How an image is sampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    /// The texel the point falls in.
+    Nearest,
+    /// The four texels around the point.
+    Bilinear,
+    /// Bilinear in the two mipmap levels around the footprint's level of detail, blended (the image
+    /// must hold its mipmap, [`TexImage::with_mipmaps`]).
+    Trilinear,
+}
+
 /// Where a texture's value comes from.
 #[derive(Debug)]
 pub enum Source {
@@ -40,8 +54,8 @@ pub enum Source {
     Image {
         /// The image (shared).
         image: Arc<TexImage>,
-        /// Bilinear (else nearest).
-        bilinear: bool,
+        /// Sampling.
+        filter: Filter,
         /// Texel divisor.
         normalizer: f32,
         /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
@@ -70,7 +84,7 @@ pub struct Texture {
 }
 
 /// Where a surface is sampled, in object space: texture coordinates, the point, the shading normal and
-/// the derivatives of the point along u and v.
+/// the derivatives of the point along u and v; and the width of the pixel's footprint there.
 #[derive(Debug, Clone, Copy)]
 pub struct TexPoint {
     /// Texture coordinates.
@@ -83,15 +97,22 @@ pub struct TexPoint {
     pub dpdu: Vec3,
     /// ∂p/∂v.
     pub dpdv: Vec3,
+    /// Side of the pixel's footprint in (u, v) units, for trilinear filtering; 0 when not known (the
+    /// finest level).
+    pub footprint: f32,
 }
 
 impl Texture {
     /// The texture's value at `at`, normalised (images divided by their normalizer).
     pub fn eval(&self, at: &TexPoint) -> Color {
         match &self.source {
-            Source::Image { image, bilinear, normalizer, clamp } => {
+            Source::Image { image, filter, normalizer, clamp } => {
                 let uv = if *clamp { at.uv.clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON)) } else { at.uv };
-                let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
+                let c = match filter {
+                    Filter::Nearest => image.nearest(uv),
+                    Filter::Bilinear => image.bilinear(uv),
+                    Filter::Trilinear => image.trilinear(uv, at.footprint),
+                };
                 c / *normalizer
             }
             Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.p * *scale), *absval)),
@@ -102,8 +123,14 @@ impl Texture {
     /// The value at texture coordinates `uv` alone (a background): procedural textures see the point
     /// (u, v, 0).
     pub fn eval_uv(&self, uv: Vec2) -> Color {
-        let at = TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y };
+        let at = TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 };
         self.eval(&at)
+    }
+
+    /// Whether sampling reads [`TexPoint::footprint`] (only trilinear images do).
+    #[inline]
+    pub fn wants_footprint(&self) -> bool {
+        matches!(self.source, Source::Image { filter: Filter::Trilinear, .. })
     }
 
     /// The bump-mapped object-space normal at `at`: the surface displaced along its normal by the
@@ -196,7 +223,7 @@ mod tests {
 
     fn image_texture(decal: Decal, bump_factor: f32, image: TexImage) -> Texture {
         Texture {
-            source: Source::Image { image: Arc::new(image), bilinear: false, normalizer: 255.0, clamp: false },
+            source: Source::Image { image: Arc::new(image), filter: Filter::Nearest, normalizer: 255.0, clamp: false },
             decal,
             bump_factor,
         }
@@ -204,7 +231,7 @@ mod tests {
 
     /// The plane z = 0 with (u, v) = (x, y).
     fn plane_point(uv: Vec2) -> TexPoint {
-        TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y }
+        TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 }
     }
 
     #[test]
