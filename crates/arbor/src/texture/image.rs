@@ -165,4 +165,30 @@ mod tests {
         // x = 0.5, y = 0.5: the mean of all four.
         assert!(i.bilinear(Vec2::new(0.25, 0.25)).abs_diff_eq(Color::new(127.5, 127.5, 127.5), 1e-4));
     }
+
+    /// 3x3 greys, texel (x, y) at index 3y + x.
+    fn grid() -> TexImage {
+        TexImage::from_rgb8(3, 3, [0u8, 10, 20, 30, 40, 80, 60, 120, 200].iter().flat_map(|&g| [g; 3]).collect())
+    }
+
+    #[test]
+    fn image_bilinear_matches_a_value_worked_by_hand() {
+        // Texel coordinates (1.25, 1.5): weights 0.75 * 0.5 on (1, 1) = 40 and on (1, 2) = 120, 0.25 * 0.5
+        // on (2, 1) = 80 and on (2, 2) = 200: 15 + 45 + 10 + 25 = 95.
+        let v = grid().bilinear(Vec2::new(1.25 / 3.0, 0.5));
+        assert!((v.x - 95.0).abs() < 1e-3, "{v}");
+        // (2.5, 0.5): the right neighbours are past the edge and repeat column 2: the mean of (2, 0) = 20
+        // and (2, 1) = 80.
+        let v = grid().bilinear(Vec2::new(2.5 / 3.0, 0.5 / 3.0));
+        assert!((v.x - 50.0).abs() < 1e-3, "{v}");
+    }
+
+    #[test]
+    fn image_nearest_takes_the_texel_on_the_far_side_of_an_edge() {
+        let g = grid();
+        let at = |x: f32, y: f32| g.nearest(Vec2::new(x / 3.0, y / 3.0)).x;
+        // Texel centres, then the edge x = 1 belonging to column 1 and just before it to column 0.
+        assert_eq!([at(0.5, 0.5), at(1.5, 1.5), at(2.5, 2.5)], [0.0, 40.0, 200.0]);
+        assert_eq!([at(1.0, 0.5), at(0.999, 0.5), at(1.0, 2.0)], [10.0, 0.0, 120.0]);
+    }
 }

@@ -248,6 +248,60 @@ mod tests {
     }
 
     #[test]
+    fn image_texture_repeats_or_clamps_outside_the_unit_square() {
+        // One row of 4 texels: 0, 51, 102, 153 (0, 0.2, 0.4, 0.6 after the normalizer).
+        let row = || TexImage::from_rgb8(4, 1, [0u8, 51, 102, 153].iter().flat_map(|&g| [g; 3]).collect());
+        let repeat = image_texture(Decal::ReplaceKd, 1.0, row());
+        let mut clamp = image_texture(Decal::ReplaceKd, 1.0, row());
+        if let Source::Image { clamp: c, .. } = &mut clamp.source {
+            *c = true;
+        }
+        let at = |t: &Texture, u: f32| (t.eval(&plane_point(Vec2::new(u, 0.5))).x * 5.0).round() as u8;
+        for (u, repeated, clamped) in [
+            (0.125, 0, 0),
+            (0.625, 2, 2),
+            (0.0, 0, 0),
+            (0.25, 1, 1),
+            (1.0, 0, 3),
+            (-0.1, 3, 0),
+            (1.3, 1, 3),
+            (-0.8, 0, 0),
+        ] {
+            assert_eq!((at(&repeat, u), at(&clamp, u)), (repeated, clamped), "u = {u}");
+        }
+    }
+
+    #[test]
+    fn bump_map_of_a_sine_and_a_ramp_gives_the_analytic_normal() {
+        // Float heights H(x, y) = 100 + 80 sin(2πx / 32) + 3y at texel (x, y) of a 32x16 image.
+        let (w, h) = (32u32, 16u32);
+        let height = |x: f32, y: f32| 100.0 + 80.0 * (std::f32::consts::TAU * x / w as f32).sin() + 3.0 * y;
+        let texels = (0..h).flat_map(|y| (0..w).flat_map(move |x| [height(x as f32, y as f32); 3])).collect();
+        let image = TexImage::from_texels(w, h, image::Texels::F32(texels));
+        let k = 0.05;
+        let t = image_texture(Decal::BumpNormal, k, image);
+        // A tilted plane: ∂p/∂u = a e1, ∂p/∂v = b e2, normal e1 x e2.
+        let (e1, e2) = (Vec3::new(1.0, 1.0, 0.0).normalize(), Vec3::Z);
+        let n = e1.cross(e2);
+        let (a, b) = (2.0, 0.5);
+        let base = Shaded { ambient: Color::ZERO, diffuse: Color::ONE, specular: Color::ZERO, n, replace_all: None };
+        for (x, y) in [(0, 0), (3, 2), (7, 5), (12, 9), (20, 14), (31, 3)] {
+            let uv = Vec2::new((x as f32 + 0.3) / w as f32, (y as f32 + 0.6) / h as f32);
+            let at = TexPoint { uv, p: Vec3::ZERO, n, dpdu: a * e1, dpdv: b * e2, footprint: 0.0 };
+            // The surface p + k H n has tangents a e1 + k H_u n and b e2 + k H_v n, so its normal is
+            // (-k H_u / a, -k H_v / b, 1) in the frame (e1, e2, n); a height is a texel's, and H_u its
+            // difference to the next texel: the derivative halfway between them, per texel.
+            let hu =
+                80.0 * std::f32::consts::TAU / w as f32 * (std::f32::consts::TAU * (x as f32 + 0.5) / w as f32).cos();
+            let hv = 3.0;
+            let expected = (-k * hu / a * e1 - k * hv / b * e2 + n).normalize();
+            let got = apply([&t], base, &at).n;
+            // A difference is the derivative times sin(π/32) / (π/32) = 0.9984.
+            assert!(got.abs_diff_eq(expected, 2e-3), "texel ({x}, {y}): {got} vs {expected}");
+        }
+    }
+
+    #[test]
     fn decal_modes_replace_what_they_name() {
         let img = || TexImage::from_rgb8(1, 1, vec![255, 0, 51]);
         let base = Shaded {
