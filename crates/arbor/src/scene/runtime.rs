@@ -30,6 +30,9 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// The indices into [`Scene::textures`] of each object's maps, in scene-file order (mostly empty).
     pub object_textures: Vec<Vec<usize>>,
+    /// Whether some map reads a hit's footprint ([`Texture::wants_footprint`]); if none does, no hit
+    /// works one out.
+    pub footprints: bool,
     /// The texture that replaces the background of camera rays that miss, spanning the image plane.
     pub background_texture: Option<usize>,
     /// Lights other than the ambient light and the environment.
@@ -162,7 +165,7 @@ impl Scene {
     pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface, cone: RayCone) -> Option<Shaded> {
         let maps = self.object_textures.get(s.object as usize).filter(|t| !t.is_empty())?;
         let (mut at, to_world) = self.tex_point(ray, hit, s);
-        if maps.iter().any(|&i| self.textures[i].wants_footprint()) {
+        if self.footprints && maps.iter().any(|&i| self.textures[i].wants_footprint()) {
             let width = cone.width_at(hit.t * ray.dir.length());
             at.footprint = footprint(width, ray.dir, s.ng, &at, to_world.as_ref());
         }
