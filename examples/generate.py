@@ -4,10 +4,12 @@
 cornell_box.xml   Cornell box with a glass sphere, a copper sphere and a torus mesh (inline), METU XML.
 knot.json         a torus knot from meshes/torus_knot.ply on a mirror floor plane, METU 2025 JSON form.
 meshes/torus_knot.ply  binary little-endian PLY with vertex normals.
+trilinear.xml     a checker image texture on a ground quad running to the horizon, trilinear (mipmapped).
+textures/checker.png  8x8 texels of one-texel black and white checks (mean 127.5).
 
 Run: python3 examples/generate.py   (from the repository root)
 """
-import json, math, os, struct
+import json, math, os, struct, zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -218,6 +220,88 @@ def knot_scene():
             "Plane": {"_id": "1", "Material": "2", "Point": "1", "Normal": "0 1 0"}}}}
 
 
+def write_png(path, width, height, rgb):
+    """8-bit RGB PNG, rows from the top; `rgb` holds width * height (r, g, b) tuples."""
+    rows = b"".join(b"\0" + bytes(c for px in rgb[y * width:(y + 1) * width] for c in px) for y in range(height))
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def checker(n=8):
+    return [(255,) * 3 if (x + y) % 2 else (0,) * 3 for y in range(n) for x in range(n)]
+
+
+def trilinear_scene():
+    # replace_all shows texels in radiance units (0-255, Normalizer 1), as the course's scenes do.
+    # A ground quad 400 units deep, one texture tile per 4 units: near the horizon a pixel covers many
+    # texels, which only a mipmap averages (with one sample per pixel, nearest and bilinear alias).
+    return """<!-- Arbor's example of trilinear texture filtering: a checker image on a ground quad running to
+     the horizon, one sample per pixel. Written for this project by examples/generate.py. -->
+<Scene>
+    <MaxRecursionDepth>0</MaxRecursionDepth>
+    <BackgroundColor>120 160 220</BackgroundColor>
+    <ShadowRayEpsilon>1e-3</ShadowRayEpsilon>
+    <Cameras>
+        <Camera id="1">
+            <Position>0 2 0</Position>
+            <Gaze>0 -0.35 -1</Gaze>
+            <Up>0 1 0</Up>
+            <NearPlane>-1 1 -1 1</NearPlane>
+            <NearDistance>1.5</NearDistance>
+            <ImageResolution>256 256</ImageResolution>
+            <NumSamples>1</NumSamples>
+            <ImageName>trilinear.png</ImageName>
+        </Camera>
+    </Cameras>
+    <Lights>
+        <AmbientLight>255 255 255</AmbientLight>
+    </Lights>
+    <Materials>
+        <Material id="1">
+            <AmbientReflectance>1 1 1</AmbientReflectance>
+            <DiffuseReflectance>0 0 0</DiffuseReflectance>
+            <SpecularReflectance>0 0 0</SpecularReflectance>
+        </Material>
+    </Materials>
+    <Textures>
+        <Images>
+            <Image id="1">textures/checker.png</Image>
+        </Images>
+        <TextureMap id="1" type="image">
+            <ImageId>1</ImageId>
+            <DecalMode>replace_all</DecalMode>
+            <Interpolation>trilinear</Interpolation>
+            <Normalizer>1</Normalizer>
+        </TextureMap>
+    </Textures>
+    <VertexData>
+        -200 0 5
+        200 0 5
+        200 0 -400
+        -200 0 -400
+    </VertexData>
+    <TexCoordData>
+        -50 1.25
+        50 1.25
+        50 -100
+        -50 -100
+    </TexCoordData>
+    <Objects>
+        <Mesh id="1">
+            <Material>1</Material>
+            <Textures>1</Textures>
+            <Faces>1 2 3 1 3 4</Faces>
+        </Mesh>
+    </Objects>
+</Scene>
+"""
+
+
 if __name__ == "__main__":
     with open(os.path.join(HERE, "cornell_box.xml"), "w") as f:
         f.write(cornell_box())
@@ -226,3 +310,7 @@ if __name__ == "__main__":
     with open(os.path.join(HERE, "knot.json"), "w") as f:
         json.dump(knot_scene(), f, indent=2)
         f.write("\n")
+    os.makedirs(os.path.join(HERE, "textures"), exist_ok=True)
+    write_png(os.path.join(HERE, "textures", "checker.png"), 8, 8, checker())
+    with open(os.path.join(HERE, "trilinear.xml"), "w") as f:
+        f.write(trilinear_scene())

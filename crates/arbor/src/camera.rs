@@ -43,6 +43,32 @@ pub enum Projection {
     Orthographic,
 }
 
+/// A ray cone (Akenine-Möller et al. 2019, "Texture Level of Detail Strategies for Real-Time Ray
+/// Tracing", Ray Tracing Gems ch. 20): the width of a pixel's footprint where a ray starts and the angle
+/// it spreads at, so that at distance `t` it is `width + spread * t` wide (small angles).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RayCone {
+    /// Width at the ray's origin.
+    pub width: f32,
+    /// Spread angle, in radians.
+    pub spread: f32,
+}
+
+impl RayCone {
+    /// The cone's width at distance `t` along the ray.
+    #[inline]
+    pub fn width_at(self, t: f32) -> f32 {
+        self.width + self.spread * t
+    }
+
+    /// The cone that leaves a surface at distance `t`: as wide as this one there, spreading alike (a
+    /// flat mirror's reflection; a curved surface's own spread is left out).
+    #[inline]
+    pub fn after(self, t: f32) -> RayCone {
+        RayCone { width: self.width_at(t), spread: self.spread }
+    }
+}
+
 /// A camera ready to generate rays, with the image it makes.
 #[derive(Debug, Clone)]
 pub struct Camera {
@@ -115,6 +141,20 @@ impl Camera {
                 let focus = self.eye + dir * (focus_distance / dir.dot(-self.w));
                 let origin = self.eye + aperture * ((lens.x - 0.5) * self.u + (lens.y - 0.5) * self.v);
                 Ray::new(origin, (focus - origin).normalize())
+            }
+        }
+    }
+
+    /// The cone of a pixel's rays: a pinhole's spreads at the angle a pixel subtends at the eye (the
+    /// geometric mean of its sides, for a pixel that is not square) from a point; an orthographic
+    /// camera's starts a pixel wide and does not spread. A thin lens is taken as its pinhole.
+    pub fn pixel_cone(&self) -> RayCone {
+        let wd = &self.plane;
+        let side = ((wd.right - wd.left) / self.width as f32 * (wd.top - wd.bottom) / self.height as f32).abs().sqrt();
+        match self.projection {
+            Projection::Orthographic => RayCone { width: side, spread: 0.0 },
+            Projection::Pinhole | Projection::ThinLens { .. } => {
+                RayCone { width: 0.0, spread: (side / wd.distance).atan() }
             }
         }
     }
@@ -247,6 +287,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn camera_pixel_cone_spans_a_pixel_at_the_image_plane() {
+        // The window is 20 x 20 at distance 10 over 800 x 800 pixels: pixels 0.025 wide on the plane.
+        let square = |p| Camera::new(Vec3::new(0.0, 0.0, 20.0), -Vec3::Z, Vec3::Y, PLANE, p, 800, 800);
+        let cone = square(Projection::Pinhole).pixel_cone();
+        assert_eq!(cone.width, 0.0);
+        assert!((cone.width_at(10.0) - 0.025).abs() < 1e-6, "{cone:?}");
+        assert!((cone.after(20.0).width_at(20.0) - 0.1).abs() < 1e-5);
+        assert_eq!(square(Projection::Orthographic).pixel_cone(), RayCone { width: 0.025, spread: 0.0 });
+        // 800 x 600: pixels 0.025 x 0.0333 on the plane, the side of a square of their area.
+        let cone = camera(Projection::Pinhole).pixel_cone();
+        assert!((cone.width_at(10.0) - (0.025f32 * 20.0 / 600.0).sqrt()).abs() < 1e-6, "{cone:?}");
     }
 
     #[test]

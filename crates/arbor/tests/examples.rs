@@ -50,3 +50,39 @@ fn examples_meshes_wind_counter_clockwise_around_their_normals() {
         assert_eq!(against, 0, "{}: {against} triangles wound against their normals", entry.path().display());
     }
 }
+
+/// Mean and variance of the red channel over the rows `rows` of a film.
+fn row_stats(film: &arbor::film::Film, rows: std::ops::Range<u32>) -> (f64, f64) {
+    let w = film.width as usize;
+    let v: Vec<f64> =
+        rows.flat_map(|y| (0..w).map(move |x| y as usize * w + x)).map(|i| film.pixels[i].x as f64).collect();
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    (mean, v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / v.len() as f64)
+}
+
+#[test]
+fn examples_trilinear_checker_averages_towards_the_horizon_where_nearest_aliases() {
+    use arbor::scene::desc::{Interpolation, TextureSource};
+    let render_with = |filter: Interpolation| {
+        let mut desc = load_desc(&examples().join("trilinear.xml")).unwrap();
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        let TextureSource::Image { interpolation, .. } = &mut desc.textures[0].source else { panic!() };
+        assert_eq!(*interpolation, Interpolation::Trilinear);
+        *interpolation = filter;
+        (desc.cameras[0].width, desc.cameras[0].height) = (128, 128);
+        let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap();
+        render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap().0
+    };
+    let (tri, near) = (render_with(Interpolation::Trilinear), render_with(Interpolation::Nearest));
+    // The horizon is near row 30. Rows 34..44 see the quad 15 to 50 units away, where one pixel's
+    // footprint runs over 2 to 30 texels: one sample of nearest lands on black or white (a standard
+    // deviation of 0.5), the mipmap averages them to the image's mean, 0.5.
+    let (tm, tv) = row_stats(&tri, 34..44);
+    let (nm, nv) = row_stats(&near, 34..44);
+    assert!((tm - 0.5).abs() < 0.02 && tv < nv / 25.0, "trilinear {tm} ± {}, nearest {nm} ± {}", tv.sqrt(), nv.sqrt());
+    assert!(nv > 0.2, "nearest {nm} ± {}", nv.sqrt());
+    // Near the camera a pixel spans a tenth of a texel: the finest level, the checks' contrast stays
+    // (a bilinear blend between them).
+    let (_, close) = row_stats(&tri, 110..128);
+    assert!(close.sqrt() > 0.15, "{}", close.sqrt());
+}

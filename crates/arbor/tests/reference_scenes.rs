@@ -11,9 +11,8 @@
 //! The 2024 set has references without back-face culling (`outputs_nobfc/`), compared with an unculled
 //! render, and with it (`outputs/`), compared with a culled render wherever the two references differ.
 //! The 2025 references are the culled ones; the 2022 hw2 ones unculled (`grass/README.txt` says so, and
-//! the other scenes look the same either way); the 2022 hw4 ones unculled too, except the scenes of
-//! `HW4_EXCLUDED`, left out by name with what was measured. A scene whose mesh files are missing is skipped,
-//! by name.
+//! the other scenes look the same either way); the 2022 hw4 ones unculled too. A scene whose mesh files
+//! are missing is skipped, by name.
 //!
 //! Each test writes its results as a Markdown table to `$CARGO_TARGET_TMPDIR` (collected into
 //! `docs/reference-results.md`).
@@ -278,26 +277,11 @@ fn reference_ceng795_2022_hw2() {
     check(run("CENG 795 2022 hw2", cases, skipped, Some(FEW_SAMPLES)).1);
 }
 
-/// 2022 hw4 scenes left out of [`reference_ceng795_2022_hw4`], each with what was measured (unculled; one
-/// sample per pixel unless said) and why no reading of the assignment text matches it.
-const HW4_EXCLUDED: &[(&str, &str)] = &[("bump_mapping_transformed.xml", ELLIPSOID_BUMP)];
-/// Why the bump-mapped ellipsoid under a negative scale is left out.
-const ELLIPSOID_BUMP: &str = "a bump map on an ellipsoid under a negative non-uniform scale (-2 1 1), beside a \
-    bump-mapped mesh under a negative scale: displacing along the object-space normal (the reading that \
-    matches wood_box_all, 0.195%, galactica_static, 0.012%, and the untransformed bump-mapped spheres, \
-    0.069% and 0.032% of pixels off) leaves bump_mapping_transformed at 2.5% of pixels off, all on the \
-    ellipsoid; displacing along the world-space normal for both objects gives 52.9%, for the ellipsoid \
-    alone 0.096%, a rule by shape that no other scene tests";
-
-/// The 2022 hw4 scenes (textures), unculled, without [`HW4_EXCLUDED`].
+/// The 2022 hw4 scenes (textures), unculled: every one, Veach's "ajar" scene included.
 fn hw4_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
     let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw4"), "xml", &[("outputs", false)]);
-    assert!(cases.len() >= 21, "only {} cases found", cases.len());
-    for (scene, why) in HW4_EXCLUDED {
-        println!("EXCLUDED {scene}: {why}");
-    }
-    let excluded = |c: &Case| HW4_EXCLUDED.iter().any(|(name, _)| c.scene.file_name().is_some_and(|f| f == *name));
-    (cases.into_iter().filter(|c| !excluded(c)).collect(), skipped)
+    assert!(cases.len() >= 22, "only {} cases found", cases.len());
+    (cases, skipped)
 }
 
 #[test]

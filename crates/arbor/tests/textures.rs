@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use arbor::accel::AccelConfig;
+use arbor::camera::RayCone;
 use arbor::film::Film;
 use arbor::math::{Ray, Vec3};
 use arbor::render::{render, RenderOptions};
@@ -131,12 +132,12 @@ fn textures_of_a_moving_object_are_those_of_the_object_frozen_at_the_rays_time()
     let tmp = tempfile::tempdir().unwrap();
     write_texture(tmp.path());
     let motion = Vec3::new(0.6, 0.2, -0.3);
-    // A checkerboard (object-space point) sphere and an image-textured quad, moving.
+    // A checkerboard sphere and a checkerboard, bump-mapped quad, moving.
     let objects = |blur: &str, centre: u32| {
         format!(
-            r#"<Sphere id="1"><Material>1</Material><Textures>3</Textures><Center>{centre}</Center>
+            r#"<Sphere id="1"><Material>1</Material><Textures>3 2</Textures><Center>{centre}</Center>
             <Radius>0.5</Radius>{blur}</Sphere>
-            <Mesh id="2"><Material>1</Material><Textures>1 2</Textures>{blur}<Faces>{FACES}</Faces></Mesh>"#
+            <Mesh id="2"><Material>1</Material><Textures>3 2</Textures>{blur}<Faces>{FACES}</Faces></Mesh>"#
         )
     };
     let quad_at = |shift: Vec3| -> String {
@@ -152,10 +153,17 @@ fn textures_of_a_moving_object_are_those_of_the_object_frozen_at_the_rays_time()
     let blur = format!("<MotionBlur>{} {} {}</MotionBlur>", motion.x, motion.y, motion.z);
     let vertices = format!("{}  0 0 0.5", quad_at(Vec3::ZERO));
     let moving = load(tmp.path(), &scene(&vertices, UV, "", &objects(&blur, 5)));
+    let cone = RayCone { width: 0.0, spread: 0.0 };
+    let shade = |scene: &Scene, ray: &Ray| {
+        let hit = scene.geometry.intersect(ray, f32::INFINITY)?;
+        let mut s = scene.surface(ray, &hit);
+        let t = scene.textured(ray, &hit, &mut s, cone).unwrap();
+        Some((s.object, t.diffuse, s.ns))
+    };
     let mut checked = [0; 2];
     for (k, time) in [0.0, 0.3, 0.75, 1.0].into_iter().enumerate() {
-        // The same objects frozen where they are at `time`, by a translation (object space unchanged).
         let shift = motion * time;
+        // The quad frozen where it is at `time` by a translation (its object space unchanged).
         let frozen_objects = objects("<Transformations>t1</Transformations>", 5);
         let translation = format!(r#"<Translation id="1">{} {} {}</Translation>"#, shift.x, shift.y, shift.z);
         let frozen = load(tmp.path(), &scene(&vertices, UV, &translation, &frozen_objects));
@@ -163,18 +171,21 @@ fn textures_of_a_moving_object_are_those_of_the_object_frozen_at_the_rays_time()
             let (x, y) = ((i % 20) as f32 / 10.0 - 1.0, (i / 20) as f32 / 10.0 - 1.0 + 0.013 * k as f32);
             let dir = Vec3::new(x, y, -4.0).normalize();
             let ray = Ray::new(Vec3::new(0.0, 0.0, 6.0), dir).with_time(time);
-            let still = Ray::new(ray.origin, dir);
-            let (Some(h1), Some(h2)) =
-                (moving.geometry.intersect(&ray, f32::INFINITY), frozen.geometry.intersect(&still, f32::INFINITY))
-            else {
-                continue;
-            };
-            let (mut s1, mut s2) = (moving.surface(&ray, &h1), frozen.surface(&still, &h2));
-            let (t1, t2) =
-                (moving.textured(&ray, &h1, &mut s1).unwrap(), frozen.textured(&still, &h2, &mut s2).unwrap());
-            assert!(t1.diffuse.abs_diff_eq(t2.diffuse, 1e-3), "time {time}, ray {i}: {} vs {}", t1.diffuse, t2.diffuse);
-            assert!(s1.ns.abs_diff_eq(s2.ns, 1e-3), "time {time}, ray {i}: normal {} vs {}", s1.ns, s2.ns);
-            checked[usize::from(s1.object == 1)] += 1;
+            let Some((object, diffuse, ns)) = shade(&moving, &ray) else { continue };
+            // The same surface point met at time 0 by the ray moved back: the texture moves with the
+            // object, it does not slide over it during the shutter.
+            let back = Ray::new(ray.origin - shift, dir);
+            let (o0, d0, n0) = shade(&moving, &back).unwrap();
+            assert_eq!(o0, object);
+            assert!(diffuse.abs_diff_eq(d0, 1e-3), "time {time}, ray {i}: {diffuse} vs {d0} at time 0");
+            assert!(ns.abs_diff_eq(n0, 1e-3), "time {time}, ray {i}: normal {ns} vs {n0} at time 0");
+            if object == 1 {
+                let (o2, d2, n2) = shade(&frozen, &Ray::new(ray.origin, dir)).unwrap();
+                assert_eq!(o2, 1);
+                assert!(diffuse.abs_diff_eq(d2, 1e-3), "time {time}, ray {i}: {diffuse} vs {d2} frozen");
+                assert!(ns.abs_diff_eq(n2, 1e-3), "time {time}, ray {i}: normal {ns} vs {n2} frozen");
+            }
+            checked[usize::from(object == 1)] += 1;
         }
     }
     assert!(checked[0] > 100 && checked[1] > 100, "rays met both objects: {checked:?}");

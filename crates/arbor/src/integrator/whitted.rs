@@ -3,8 +3,9 @@
 //! dielectrics up to the recursion limit, with Beer's law along every segment travelled inside glass.
 //! Glass seen from inside gets no ambient or Blinn-Phong terms, only its lobes.
 //!
-//! Every ray of a camera sample keeps its time (motion blur). Rough materials send their lobes'
-//! rays off the ideal directions ([`crate::material::perturb`]), one random choice per lobe.
+//! Every ray of a camera sample keeps its time (motion blur) and the pixel's ray cone, widened along
+//! every segment travelled (for trilinear textures; [`crate::camera::RayCone`]). Rough materials send
+//! their lobes' rays off the ideal directions ([`crate::material::perturb`]), one random choice per lobe.
 //!
 //! Secondary ray origins are pushed off the surface, by the scene's `ShadowRayEpsilon` or by the hit
 //! point's floating-point error bound ([`super::offset::spawn_origin`] decides): to the side the new ray
@@ -17,7 +18,7 @@
 
 use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
-use crate::camera::Camera;
+use crate::camera::{Camera, RayCone};
 use crate::material::{beer, blinn_phong, perturb, Material};
 use crate::math::{Color, Ray, Vec2};
 use crate::sampler::Rng;
@@ -28,22 +29,35 @@ pub struct Whitted<'a> {
     scene: &'a Scene,
     cull_backfaces: bool,
     camera: Option<&'a Camera>,
+    /// The camera's pixel cone (zero without a camera: the finest texture level).
+    cone: RayCone,
+}
+
+/// What a ray carries down the recursion.
+#[derive(Clone, Copy)]
+struct Carried {
+    /// Specular bounces so far.
+    depth: u32,
+    /// The absorption of the glass the ray travels in, if any.
+    inside: Option<Color>,
+    /// The pixel's cone, as wide as it is where the ray starts.
+    cone: RayCone,
 }
 
 impl<'a> Whitted<'a> {
     /// An integrator over `scene`; `cull_backfaces` applies to camera rays only.
     pub fn new(scene: &'a Scene, cull_backfaces: bool) -> Self {
-        Whitted { scene, cull_backfaces, camera: None }
+        Whitted { scene, cull_backfaces, camera: None, cone: RayCone::default() }
     }
 
     /// The integrator for the camera rays of `camera`, which a background texture spans.
     pub fn with_camera(self, camera: &'a Camera) -> Self {
-        Whitted { camera: Some(camera), ..self }
+        Whitted { camera: Some(camera), cone: camera.pixel_cone(), ..self }
     }
 
     /// Radiance (in the scene's units) along a camera ray.
     pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, count: &mut u64) -> Color {
-        self.li(&self.camera_ray(ray), 0, None, rng, count)
+        self.li(&self.camera_ray(ray), self.camera_carried(), rng, count)
     }
 
     /// The camera ray as it is traced: culling back faces if the render asks for it.
@@ -56,27 +70,23 @@ impl<'a> Whitted<'a> {
     /// closest hit.
     pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
         *count += 1;
-        self.shade(ray, hit, 0, None, rng, count)
+        self.shade(ray, hit, self.camera_carried(), rng, count)
     }
 
-    /// Radiance along `ray` at recursion `depth`; `inside` is the absorption of the glass the ray travels
-    /// in, if any.
-    fn li(&self, ray: &Ray, depth: u32, inside: Option<Color>, rng: &mut Rng, count: &mut u64) -> Color {
+    fn camera_carried(&self) -> Carried {
+        Carried { depth: 0, inside: None, cone: self.cone }
+    }
+
+    /// Radiance along `ray`.
+    fn li(&self, ray: &Ray, carried: Carried, rng: &mut Rng, count: &mut u64) -> Color {
         *count += 1;
         let hit = self.scene.geometry.intersect(ray, f32::INFINITY);
-        self.shade(ray, hit, depth, inside, rng, count)
+        self.shade(ray, hit, carried, rng, count)
     }
 
-    /// Radiance along `ray` at recursion `depth` given its closest hit.
-    fn shade(
-        &self,
-        ray: &Ray,
-        hit: Option<Hit>,
-        depth: u32,
-        inside: Option<Color>,
-        rng: &mut Rng,
-        count: &mut u64,
-    ) -> Color {
+    /// Radiance along `ray` given its closest hit.
+    fn shade(&self, ray: &Ray, hit: Option<Hit>, carried: Carried, rng: &mut Rng, count: &mut u64) -> Color {
+        let Carried { depth, inside, cone } = carried;
         let scene = self.scene;
         let Some(hit) = hit else {
             return self.miss(ray, depth);
@@ -84,7 +94,7 @@ impl<'a> Whitted<'a> {
         let mut s = scene.surface(ray, &hit);
         let m = scene.material(&s);
         // Textures replace the Blinn-Phong terms and the shading normal; the specular layer stays.
-        let textured = scene.textured(ray, &hit, &mut s);
+        let textured = scene.textured(ray, &hit, &mut s, cone);
         if let Some(c) = textured.and_then(|t| t.replace_all) {
             return c;
         }
@@ -145,7 +155,8 @@ impl<'a> Whitted<'a> {
                     (true, true) => m.interior_absorption(),
                     (true, false) => None,
                 };
-                let l = self.li(&Ray::new(origin, dir).with_time(ray.time), depth + 1, next_inside, rng, count);
+                let next = Carried { depth: depth + 1, inside: next_inside, cone: cone.after(hit.t * d.length()) };
+                let l = self.li(&Ray::new(origin, dir).with_time(ray.time), next, rng, count);
                 color += lobe.weight * l;
             }
         }

@@ -59,6 +59,7 @@ impl Scene {
             object_materials: desc.objects.iter().map(|o| o.material).collect(),
             background_texture: textures.iter().position(|t| t.decal == Decal::ReplaceBackground),
             object_textures: desc.objects.iter().map(|o| o.textures.clone()).collect(),
+            footprints: textures.iter().any(|t| t.wants_footprint()),
             textures,
             lights,
             cameras: desc.cameras.iter().map(build_camera).collect(),

@@ -8,13 +8,13 @@ use std::time::Duration;
 
 use super::geometry::{displacement, SceneGeometry, ScenePlane, Shape};
 use crate::accel::Hit;
-use crate::camera::Camera;
+use crate::camera::{Camera, RayCone};
 use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, triangle_point};
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Color, Mat3, Ray, Transform, Vec2, Vec3};
+use crate::math::{Color, Ray, Transform, Vec2, Vec3};
 use crate::texture::{self, Shaded, TexPoint, Texture};
 
 /// A scene ready to render.
@@ -30,6 +30,9 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// The indices into [`Scene::textures`] of each object's maps, in scene-file order (mostly empty).
     pub object_textures: Vec<Vec<usize>>,
+    /// Whether some map reads a hit's footprint ([`Texture::wants_footprint`]); if none does, no hit
+    /// works one out.
+    pub footprints: bool,
     /// The texture that replaces the background of camera rays that miss, spanning the image plane.
     pub background_texture: Option<usize>,
     /// Lights other than the ambient light and the environment.
@@ -157,10 +160,15 @@ impl Scene {
 
 impl Scene {
     /// The Blinn-Phong terms of `s` after its object's textures, with `s.ns` replaced by the textured
-    /// normal (in world space); `None`, and `s` unchanged, for an object without textures.
-    pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface) -> Option<Shaded> {
+    /// normal (in world space); `None`, and `s` unchanged, for an object without textures. `cone` is the
+    /// ray's, for the footprint that trilinear maps filter over.
+    pub fn textured(&self, ray: &Ray, hit: &Hit, s: &mut Surface, cone: RayCone) -> Option<Shaded> {
         let maps = self.object_textures.get(s.object as usize).filter(|t| !t.is_empty())?;
-        let (at, to_world) = self.tex_point(ray, hit, s);
+        let (mut at, to_world) = self.tex_point(ray, hit, s);
+        if self.footprints && maps.iter().any(|&i| self.textures[i].wants_footprint()) {
+            let width = cone.width_at(hit.t * ray.dir.length());
+            at.footprint = footprint(width, ray.dir, s.ng, &at, to_world.as_ref());
+        }
         let m = self.material(s);
         let base = Shaded { ambient: m.ambient, diffuse: m.diffuse, specular: m.specular, n: at.n, replace_all: None };
         let out = texture::apply(maps.iter().map(|&i| &self.textures[i]), base, &at);
@@ -174,7 +182,8 @@ impl Scene {
         Some(out)
     }
 
-    /// The object-space sampling point of a hit and the object's transform (`None` for the identity).
+    /// The sampling point of a hit in its texture frame ([`TexPoint`]) and the transform from that frame
+    /// to world space (`None` for the identity).
     fn tex_point(&self, ray: &Ray, hit: &Hit, s: &Surface) -> (TexPoint, Option<Transform>) {
         let still = |motion| s.p - displacement(motion, ray.time);
         match self.geometry.objects.objects.get(hit.prim as usize) {
@@ -198,35 +207,32 @@ impl Scene {
                         }
                         None => (Vec2::ZERO, Vec3::ZERO, Vec3::ZERO),
                     };
-                    (TexPoint { uv, p, n, dpdu, dpdv, solid: p, solid_from_p: Mat3::IDENTITY }, o.transform)
+                    (TexPoint { uv, p, n, dpdu, dpdv, footprint: 0.0 }, o.transform)
                 }
                 Shape::Sphere(sp) => {
-                    let t = (!sp.transform.is_identity()).then_some(sp.transform);
+                    // In world space (see TexPoint): (u, v) from the sphere's own point, its tangents
+                    // carried by the transform, its normal by the inverse transpose.
                     let world = still(o.motion);
-                    let local = t.map_or(world, |t| t.inv.transform_point3(world));
-                    // A sphere's noise is read at its world-space point, a mesh's at its object-space one:
-                    // so the course's renderer textures them (hw4 ellipsoids_texture, cube_perlin).
-                    let at = TexPoint {
-                        solid: world,
-                        solid_from_p: t.map_or(Mat3::IDENTITY, |t| Mat3::from_mat4(t.m)),
-                        ..sphere_tex_point(local, sp.center, sp.radius)
+                    let at = if sp.transform.is_identity() {
+                        sphere_tex_point(world, sp.center, sp.radius)
+                    } else {
+                        let t = &sp.transform;
+                        let local = sphere_tex_point(t.inv.transform_point3(world), sp.center, sp.radius);
+                        TexPoint {
+                            p: world,
+                            n: t.normal(local.n).normalize_or(s.ns),
+                            dpdu: t.vector(local.dpdu),
+                            dpdv: t.vector(local.dpdv),
+                            ..local
+                        }
                     };
-                    (at, t)
+                    (at, None)
                 }
             },
             None => {
                 let plane = &self.geometry.planes[hit.prim as usize - self.geometry.objects.objects.len()];
                 let (p, n) = (still(plane.motion), plane.plane.normal);
-                let at = TexPoint {
-                    uv: Vec2::ZERO,
-                    p,
-                    n,
-                    dpdu: Vec3::ZERO,
-                    dpdv: Vec3::ZERO,
-                    solid: p,
-                    solid_from_p: Mat3::IDENTITY,
-                };
-                (at, None)
+                (TexPoint { uv: Vec2::ZERO, p, n, dpdu: Vec3::ZERO, dpdv: Vec3::ZERO, footprint: 0.0 }, None)
             }
         }
     }
@@ -242,7 +248,26 @@ fn sphere_tex_point(p: Vec3, center: Vec3, radius: f32) -> TexPoint {
     let uv = Vec2::new((PI - phi) / (2.0 * PI), theta / PI);
     let dpdu = 2.0 * PI * Vec3::new(r.z, 0.0, -r.x);
     let dpdv = PI * Vec3::new(r.y * phi.cos(), -radius * theta.sin(), r.y * phi.sin());
-    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv, solid: p, solid_from_p: Mat3::IDENTITY }
+    TexPoint { uv, p, n: (r / radius).normalize_or(Vec3::Y), dpdu, dpdv, footprint: 0.0 }
+}
+
+/// The side in (u, v) units of a ray cone `width` wide meeting a surface of unit normal `ng` along `dir`
+/// at `at` (Akenine-Möller et al. 2019): the cone's width over `|cos θ|`, times the surface's texel
+/// density `1 / sqrt(|∂p/∂u × ∂p/∂v|)` in world space (for a triangle, the square root of its (u, v)
+/// area over its world area). 0, the finest level, where the derivatives are not known (no (u, v),
+/// a sphere's poles); at grazing angles, past every level.
+fn footprint(width: f32, dir: Vec3, ng: Vec3, at: &TexPoint, to_world: Option<&Transform>) -> f32 {
+    let (du, dv) = match to_world {
+        Some(t) => (t.vector(at.dpdu), t.vector(at.dpdv)),
+        None => (at.dpdu, at.dpdv),
+    };
+    let area = du.cross(dv).length();
+    if area > 0.0 {
+        let cos = dir.normalize_or_zero().dot(ng).abs();
+        width / (cos * area.sqrt())
+    } else {
+        0.0
+    }
 }
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal
@@ -265,6 +290,30 @@ fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn footprint_is_the_cone_width_in_uv_units_stretched_by_the_angle() {
+        // A plane with u = x / 4, v = y / 2 (∂p/∂u = 4x, ∂p/∂v = 2y): sqrt(8) world units per (u, v) unit.
+        let at = TexPoint {
+            uv: Vec2::ZERO,
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            dpdu: 4.0 * Vec3::X,
+            dpdv: 2.0 * Vec3::Y,
+            footprint: 0.0,
+        };
+        let f = footprint(0.5, -Vec3::Z, Vec3::Z, &at, None);
+        assert!((f - 0.5 / 8f32.sqrt()).abs() < 1e-6, "{f}");
+        // At 60° from the normal the cone's section is twice as long.
+        let dir = Vec3::new(3f32.sqrt() / 2.0, 0.0, -0.5) * 3.0;
+        assert!((footprint(0.5, dir, Vec3::Z, &at, None) - 2.0 * f).abs() < 1e-6);
+        // Scaled up twice by its transform, the plane holds four times the area per (u, v) unit.
+        let t = Transform::scale(Vec3::splat(2.0)).unwrap();
+        assert!((footprint(0.5, -Vec3::Z, Vec3::Z, &at, Some(&t)) - f / 2.0).abs() < 1e-6);
+        // No derivatives: the finest level.
+        let flat = TexPoint { dpdu: Vec3::ZERO, ..at };
+        assert_eq!(footprint(0.5, -Vec3::Z, Vec3::Z, &flat, None), 0.0);
+    }
 
     #[test]
     fn sphere_tex_point_follows_the_course_spherical_coordinates() {

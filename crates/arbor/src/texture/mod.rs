@@ -1,15 +1,17 @@
-//! Textures at render time (CENG 795 2022 hw4): image textures ([`TexImage`]), Perlin noise ([`perlin`])
-//! and a 3D checkerboard ([`Checkerboard`]), each with the decal mode that says what its value replaces;
-//! [`apply`] applies an object's textures to its shading terms and normal, in one place. The build step
-//! makes them from the description; nothing here knows the scene file.
+//! Textures at render time (CENG 795 2022 hw4): image textures ([`TexImage`], nearest, bilinear or
+//! trilinear over a mipmap), Perlin noise ([`perlin`]) and a 3D checkerboard ([`Checkerboard`]), each
+//! with the decal mode that says what its value replaces; [`apply`] applies an object's textures to its
+//! shading terms and normal, in one place. The build step makes them from the description; nothing here
+//! knows the scene file.
 
 mod checker;
 mod image;
+mod mipmap;
 pub mod perlin;
 
 use std::sync::Arc;
 
-use crate::math::{Color, Mat3, Vec2, Vec3};
+use crate::math::{Color, Vec2, Vec3};
 
 pub use checker::Checkerboard;
 pub use image::TexImage;
@@ -33,6 +35,18 @@ pub enum Decal {
     BumpNormal,
 }
 
+/// How an image is sampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    /// The texel the point falls in.
+    Nearest,
+    /// The four texels around the point.
+    Bilinear,
+    /// Bilinear in the two mipmap levels around the footprint's level of detail, blended (the image
+    /// must hold its mipmap, [`TexImage::with_mipmaps`]).
+    Trilinear,
+}
+
 /// Where a texture's value comes from.
 #[derive(Debug)]
 pub enum Source {
@@ -40,14 +54,14 @@ pub enum Source {
     Image {
         /// The image (shared).
         image: Arc<TexImage>,
-        /// Bilinear (else nearest).
-        bilinear: bool,
+        /// Sampling.
+        filter: Filter,
         /// Texel divisor.
         normalizer: f32,
         /// Coordinates outside [0, 1] take the edge texels (else the image repeats).
         clamp: bool,
     },
-    /// Perlin noise at the point [`TexPoint::solid`] times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
+    /// Perlin noise at the point [`TexPoint::p`] times `scale`, made [0, 1] by `|n|` or `(n + 1) / 2`.
     Perlin {
         /// `|n|` (else linear).
         absval: bool,
@@ -69,39 +83,44 @@ pub struct Texture {
     pub bump_factor: f32,
 }
 
-/// Where a surface is sampled, in object space: texture coordinates, the point, the shading normal and
-/// the derivatives of the point along u and v; and the point Perlin noise reads, which is not always
-/// the object-space one.
+/// Where a surface is sampled: texture coordinates, the point, the shading normal and the derivatives of
+/// the point along u and v, in the surface's texture frame; and the width of the pixel's footprint there.
+///
+/// The frame is a mesh's or plane's object space, and a sphere's world space: so the course's renderer
+/// textures them (its Perlin noise reads a sphere's world point, hw4 `ellipsoids_texture`; its bump maps
+/// displace a transformed sphere along the world normal, `bump_mapping_transformed`), while a mesh's
+/// bump heights scale with its transform (`bump_mapping_transformed`'s floor).
 #[derive(Debug, Clone, Copy)]
 pub struct TexPoint {
     /// Texture coordinates.
     pub uv: Vec2,
-    /// Object-space point (where the object is at time 0).
+    /// The point, where the object is at time 0; procedural textures read it.
     pub p: Vec3,
-    /// Unit object-space shading normal.
+    /// Unit shading normal.
     pub n: Vec3,
     /// ∂p/∂u.
     pub dpdu: Vec3,
     /// ∂p/∂v.
     pub dpdv: Vec3,
-    /// The point Perlin noise reads: the object-space point of a mesh or plane, the world-space point
-    /// (at time 0) of a sphere, as the course's reference images have it.
-    pub solid: Vec3,
-    /// ∂solid/∂p: the linear part of the map from `p` to `solid` (identity when they are the same), to
-    /// bring the noise's gradient back to object space.
-    pub solid_from_p: Mat3,
+    /// Side of the pixel's footprint in (u, v) units, for trilinear filtering; 0 when not known (the
+    /// finest level).
+    pub footprint: f32,
 }
 
 impl Texture {
     /// The texture's value at `at`, normalised (images divided by their normalizer).
     pub fn eval(&self, at: &TexPoint) -> Color {
         match &self.source {
-            Source::Image { image, bilinear, normalizer, clamp } => {
+            Source::Image { image, filter, normalizer, clamp } => {
                 let uv = if *clamp { at.uv.clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON)) } else { at.uv };
-                let c = if *bilinear { image.bilinear(uv) } else { image.nearest(uv) };
+                let c = match filter {
+                    Filter::Nearest => image.nearest(uv),
+                    Filter::Bilinear => image.bilinear(uv),
+                    Filter::Trilinear => image.trilinear(uv, at.footprint),
+                };
                 c / *normalizer
             }
-            Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.solid * *scale), *absval)),
+            Source::Perlin { absval, scale } => Color::splat(convert(perlin::noise(at.p * *scale), *absval)),
             Source::Checker(c) => c.eval(at.p),
         }
     }
@@ -109,9 +128,14 @@ impl Texture {
     /// The value at texture coordinates `uv` alone (a background): procedural textures see the point
     /// (u, v, 0).
     pub fn eval_uv(&self, uv: Vec2) -> Color {
-        let p = uv.extend(0.0);
-        let at = TexPoint { uv, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: p, solid_from_p: Mat3::IDENTITY };
+        let at = TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 };
         self.eval(&at)
+    }
+
+    /// Whether sampling reads [`TexPoint::footprint`] (only trilinear images do).
+    #[inline]
+    pub fn wants_footprint(&self) -> bool {
+        matches!(self.source, Source::Image { filter: Filter::Trilinear, .. })
     }
 
     /// The bump-mapped object-space normal at `at`: the surface displaced along its normal by the
@@ -142,11 +166,10 @@ impl Texture {
                 }
             }
             Source::Perlin { absval, scale } => {
-                let q = at.solid * *scale;
+                let q = at.p * *scale;
                 let nv = perlin::noise(q);
                 let slope = if *absval { nv.signum() } else { 0.5 };
-                // The chain rule through p -> solid: the object-space gradient is Jᵀ times the noise's.
-                let g = at.solid_from_p.transpose() * perlin::gradient(q) * (slope * *scale * k);
+                let g = perlin::gradient(q) * (slope * *scale * k);
                 (n - (g - g.dot(n) * n)).normalize_or(n)
             }
             Source::Checker(_) => n,
@@ -205,7 +228,7 @@ mod tests {
 
     fn image_texture(decal: Decal, bump_factor: f32, image: TexImage) -> Texture {
         Texture {
-            source: Source::Image { image: Arc::new(image), bilinear: false, normalizer: 255.0, clamp: false },
+            source: Source::Image { image: Arc::new(image), filter: Filter::Nearest, normalizer: 255.0, clamp: false },
             decal,
             bump_factor,
         }
@@ -213,8 +236,7 @@ mod tests {
 
     /// The plane z = 0 with (u, v) = (x, y).
     fn plane_point(uv: Vec2) -> TexPoint {
-        let p = uv.extend(0.0);
-        TexPoint { uv, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: p, solid_from_p: Mat3::IDENTITY }
+        TexPoint { uv, p: uv.extend(0.0), n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 }
     }
 
     #[test]
@@ -228,6 +250,60 @@ mod tests {
         // Height k·h rises by 0.5 · 10 per unit of u: the surface z = 5u has normal (-5, 0, 1)/|.|.
         assert!(out.n.abs_diff_eq(Vec3::new(-5.0, 0.0, 1.0).normalize(), 1e-5), "{}", out.n);
         assert_eq!(out.diffuse, Color::ONE);
+    }
+
+    #[test]
+    fn image_texture_repeats_or_clamps_outside_the_unit_square() {
+        // One row of 4 texels: 0, 51, 102, 153 (0, 0.2, 0.4, 0.6 after the normalizer).
+        let row = || TexImage::from_rgb8(4, 1, [0u8, 51, 102, 153].iter().flat_map(|&g| [g; 3]).collect());
+        let repeat = image_texture(Decal::ReplaceKd, 1.0, row());
+        let mut clamp = image_texture(Decal::ReplaceKd, 1.0, row());
+        if let Source::Image { clamp: c, .. } = &mut clamp.source {
+            *c = true;
+        }
+        let at = |t: &Texture, u: f32| (t.eval(&plane_point(Vec2::new(u, 0.5))).x * 5.0).round() as u8;
+        for (u, repeated, clamped) in [
+            (0.125, 0, 0),
+            (0.625, 2, 2),
+            (0.0, 0, 0),
+            (0.25, 1, 1),
+            (1.0, 0, 3),
+            (-0.1, 3, 0),
+            (1.3, 1, 3),
+            (-0.8, 0, 0),
+        ] {
+            assert_eq!((at(&repeat, u), at(&clamp, u)), (repeated, clamped), "u = {u}");
+        }
+    }
+
+    #[test]
+    fn bump_map_of_a_sine_and_a_ramp_gives_the_analytic_normal() {
+        // Float heights H(x, y) = 100 + 80 sin(2πx / 32) + 3y at texel (x, y) of a 32x16 image.
+        let (w, h) = (32u32, 16u32);
+        let height = |x: f32, y: f32| 100.0 + 80.0 * (std::f32::consts::TAU * x / w as f32).sin() + 3.0 * y;
+        let texels = (0..h).flat_map(|y| (0..w).flat_map(move |x| [height(x as f32, y as f32); 3])).collect();
+        let image = TexImage::from_texels(w, h, image::Texels::F32(texels));
+        let k = 0.05;
+        let t = image_texture(Decal::BumpNormal, k, image);
+        // A tilted plane: ∂p/∂u = a e1, ∂p/∂v = b e2, normal e1 x e2.
+        let (e1, e2) = (Vec3::new(1.0, 1.0, 0.0).normalize(), Vec3::Z);
+        let n = e1.cross(e2);
+        let (a, b) = (2.0, 0.5);
+        let base = Shaded { ambient: Color::ZERO, diffuse: Color::ONE, specular: Color::ZERO, n, replace_all: None };
+        for (x, y) in [(0, 0), (3, 2), (7, 5), (12, 9), (20, 14), (31, 3)] {
+            let uv = Vec2::new((x as f32 + 0.3) / w as f32, (y as f32 + 0.6) / h as f32);
+            let at = TexPoint { uv, p: Vec3::ZERO, n, dpdu: a * e1, dpdv: b * e2, footprint: 0.0 };
+            // The surface p + k H n has tangents a e1 + k H_u n and b e2 + k H_v n, so its normal is
+            // (-k H_u / a, -k H_v / b, 1) in the frame (e1, e2, n); a height is a texel's, and H_u its
+            // difference to the next texel: the derivative halfway between them, per texel.
+            let hu =
+                80.0 * std::f32::consts::TAU / w as f32 * (std::f32::consts::TAU * (x as f32 + 0.5) / w as f32).cos();
+            let hv = 3.0;
+            let expected = (-k * hu / a * e1 - k * hv / b * e2 + n).normalize();
+            let got = apply([&t], base, &at).n;
+            // A difference is the derivative times sin(π/32) / (π/32) = 0.9984.
+            assert!(got.abs_diff_eq(expected, 2e-3), "texel ({x}, {y}): {got} vs {expected}");
+        }
     }
 
     #[test]
@@ -255,21 +331,17 @@ mod tests {
     }
 
     #[test]
-    fn perlin_bump_follows_the_noise_through_the_solid_map() {
-        // A point whose noise is read at solid = M p (a sphere under a transform): the bumped normal must
-        // tilt against the slope of p -> noise(scale · M p), which differs from the slope in solid space.
-        let m = Mat3::from_cols(Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.5, 3.0));
+    fn perlin_bump_tilts_the_normal_against_the_noise_slope() {
         let scale = 0.7;
         let t = Texture { source: Source::Perlin { absval: false, scale }, decal: Decal::BumpNormal, bump_factor: 2.0 };
-        let p = Vec3::new(0.41, 1.37, 0.2);
-        let at =
-            TexPoint { uv: Vec2::ZERO, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, solid: m * p, solid_from_p: m };
+        let p = Vec3::new(0.82, 1.47, 0.6);
+        let at = TexPoint { uv: Vec2::ZERO, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 };
         let base =
             Shaded { ambient: Color::ONE, diffuse: Color::ONE, specular: Color::ONE, n: Vec3::Z, replace_all: None };
         let out = apply([&t], base, &at);
-        // The height is 2 · (noise + 1) / 2 = noise(0.7 M p): its x and y slopes by differences in p.
+        // The height is 2 · (noise + 1) / 2 = noise(0.7 p): its x and y slopes by differences.
         let h = 1e-3;
-        let height = |q: Vec3| perlin::noise(m * q * scale);
+        let height = |q: Vec3| perlin::noise(q * scale);
         let dx = (height(p + Vec3::X * h) - height(p - Vec3::X * h)) / (2.0 * h);
         let dy = (height(p + Vec3::Y * h) - height(p - Vec3::Y * h)) / (2.0 * h);
         let want = Vec3::new(-dx, -dy, 1.0).normalize();

@@ -1,14 +1,15 @@
 //! The textures of a description as runtime types: every image that a map samples is read once, in
 //! parallel, and shared by the maps that name it; an unreadable image is an error at the `Image`
-//! element that names it.
+//! element that names it. An image gets its mipmap when a trilinear map samples it, and only then.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use crate::scene::desc::{DecalMode, Interpolation, NoiseConversion, SceneDesc, TextureDesc, TextureSource};
-use crate::texture::{Checkerboard, Decal, Source, TexImage, Texture};
+use crate::texture::{Checkerboard, Decal, Filter, Source, TexImage, Texture};
 use crate::{Error, Result};
 
 /// The runtime textures of `desc`, in its order.
@@ -23,6 +24,17 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
         .collect();
     wanted.sort_unstable();
     wanted.dedup();
+    // By path: two ids of one file share one decoded image below, which a trilinear map of either needs.
+    let mipmapped: HashSet<&Path> = desc
+        .textures
+        .iter()
+        .filter_map(|t| match t.source {
+            TextureSource::Image { image, interpolation: Interpolation::Trilinear, .. } => {
+                Some(desc.images[image].path.as_path())
+            }
+            _ => None,
+        })
+        .collect();
     let loaded: HashMap<usize, Arc<TexImage>> = wanted
         .par_iter()
         .map(|&i| {
@@ -35,11 +47,12 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
                 };
                 Error::input(img.loc.clone(), format!("cannot read texture image '{}': {why}", img.path.display()))
             })?;
+            let image = if mipmapped.contains(img.path.as_path()) { image.with_mipmaps() } else { image };
             Ok((i, Arc::new(image)))
         })
         .collect::<Result<_>>()?;
     // Share one decoded image between the maps that name the same file under different ids.
-    let mut by_path: HashMap<&std::path::Path, Arc<TexImage>> = HashMap::new();
+    let mut by_path: HashMap<&Path, Arc<TexImage>> = HashMap::new();
     let images: HashMap<usize, Arc<TexImage>> = wanted
         .iter()
         .map(|&i| (i, by_path.entry(&desc.images[i].path).or_insert_with(|| loaded[&i].clone()).clone()))
@@ -51,7 +64,11 @@ fn build_texture(t: &TextureDesc, images: &HashMap<usize, Arc<TexImage>>) -> Tex
     let source = match t.source {
         TextureSource::Image { image, interpolation, normalizer, clamp, .. } => Source::Image {
             image: images[&image].clone(),
-            bilinear: interpolation == Interpolation::Bilinear,
+            filter: match interpolation {
+                Interpolation::Nearest => Filter::Nearest,
+                Interpolation::Bilinear => Filter::Bilinear,
+                Interpolation::Trilinear => Filter::Trilinear,
+            },
             normalizer,
             clamp,
         },
@@ -110,6 +127,28 @@ mod tests {
         };
         assert!(Arc::ptr_eq(&image(&t[0]), &image(&t[1])) && Arc::ptr_eq(&image(&t[0]), &image(&t[2])));
         assert!(image(&t[0]).is_8bit());
+    }
+
+    #[test]
+    fn build_textures_mipmaps_only_images_that_a_trilinear_map_samples() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut desc = SceneDesc::new("t.xml");
+        for name in ["a.png", "b.png"] {
+            let path = dir.path().join(name);
+            image::RgbImage::from_raw(4, 4, vec![9; 48]).unwrap().save(&path).unwrap();
+            desc.images.push(ImageDesc { path, loc: Location::file("t.xml") });
+        }
+        // a.png under a second id too, sampled nearest there and trilinear through the first id.
+        desc.images.push(desc.images[0].clone());
+        desc.textures =
+            vec![map(2, Interpolation::Nearest), map(0, Interpolation::Trilinear), map(1, Interpolation::Bilinear)];
+        let t = build_textures(&desc).unwrap();
+        let levels = |t: &Texture| match &t.source {
+            Source::Image { image, .. } => image.levels(),
+            _ => unreachable!(),
+        };
+        assert_eq!([levels(&t[0]), levels(&t[1]), levels(&t[2])], [3, 3, 1]);
+        assert!(matches!(t[1].source, Source::Image { filter: Filter::Trilinear, .. }));
     }
 
     #[test]

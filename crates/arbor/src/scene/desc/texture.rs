@@ -23,6 +23,8 @@ pub enum Interpolation {
     Nearest,
     /// The four texels around the point, weighted by distance; edge texels repeat.
     Bilinear,
+    /// Bilinear in the two mipmap levels around the level of detail of the pixel's footprint, blended.
+    Trilinear,
 }
 
 /// What a texture's value replaces at a surface point.

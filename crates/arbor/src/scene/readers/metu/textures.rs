@@ -174,11 +174,13 @@ impl Reader<'_> {
         })
     }
 
-    /// `Interpolation` (nearest when absent) and `Normalizer` (255 when absent) of an image texture.
+    /// `Interpolation` (nearest when absent; an unknown value is reported and read as bilinear) and
+    /// `Normalizer` (255 when absent) of an image texture.
     fn image_sampling(&mut self, map: &Node, name: &str) -> Result<(Interpolation, f32)> {
         let interpolation = match self.one(map, "Interpolation").map(|n| (n, n.trimmed())) {
             None | Some((_, "nearest")) => Interpolation::Nearest,
             Some((_, "bilinear")) => Interpolation::Bilinear,
+            Some((_, "trilinear")) => Interpolation::Trilinear,
             Some((n, other)) => {
                 let msg = format!("{name}: unknown Interpolation '{other}'; bilinear used");
                 self.notes.plain(n.loc(self.path), msg);
@@ -314,6 +316,30 @@ mod tests {
             TextureSource::Perlin { conversion: crate::scene::desc::NoiseConversion::AbsVal, scale: 3.0 }
         ));
         assert_eq!(d.objects[0].textures, [0, 1, 2]);
+    }
+
+    #[test]
+    fn metu_interpolation_reads_trilinear_and_reports_unknown_values() {
+        let interpolation = |value: &str, legacy: bool| {
+            let i = format!("<Interpolation>{value}</Interpolation><DecalMode>replace_kd</DecalMode>");
+            let body = if legacy {
+                format!("<Textures><Texture id=\"1\"><ImageName>a.png</ImageName>{i}</Texture></Textures>")
+            } else {
+                textures(&format!("<TextureMap id=\"1\" type=\"image\"><ImageId>1</ImageId>{i}</TextureMap>"))
+            };
+            let d = read_xml(&body).unwrap();
+            let TextureSource::Image { interpolation, .. } = d.textures[0].source else { panic!() };
+            (interpolation, d.warnings)
+        };
+        for legacy in [false, true] {
+            assert_eq!(interpolation("trilinear", legacy), (Interpolation::Trilinear, Vec::<String>::new()));
+            assert_eq!(interpolation(" nearest ", legacy), (Interpolation::Nearest, Vec::<String>::new()));
+            let (i, warnings) = interpolation("cubic", legacy);
+            assert_eq!(i, Interpolation::Bilinear);
+            assert_eq!(warnings.len(), 1);
+            assert!(warnings[0].contains("unknown Interpolation 'cubic'; bilinear used"), "{warnings:?}");
+            assert!(warnings[0].starts_with("t.xml:1:"), "{warnings:?}");
+        }
     }
 
     #[test]
