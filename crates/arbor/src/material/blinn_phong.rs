@@ -30,6 +30,7 @@ mod tests {
             phong_exponent: 10.0,
             roughness: 0.0,
             layer: None,
+            degamma: false,
         }
     }
 

@@ -74,6 +74,9 @@ pub struct Material {
     pub roughness: f32,
     /// Mirror, conductor, dielectric...; `None` for Blinn-Phong only (no secondary rays).
     pub layer: Option<Box<dyn SpecularLayer>>,
+    /// Its 8-bit colour textures hold display values (`degamma`), made linear by [`DEGAMMA`] as they are
+    /// read; its own colours were made linear when it was built.
+    pub degamma: bool,
 }
 
 impl Material {

@@ -138,6 +138,7 @@ fn build_material(desc: &MaterialDesc) -> Material {
         phong_exponent: desc.phong_exponent,
         roughness: desc.roughness,
         layer,
+        degamma: desc.degamma,
     }
 }
 

@@ -13,7 +13,7 @@ use crate::geometry::error_bound::{plane_point, sphere_point, transform_point, t
 use crate::geometry::TriangleMesh;
 use crate::light::environment::EnvMap;
 use crate::light::Light;
-use crate::material::Material;
+use crate::material::{Material, DEGAMMA};
 use crate::math::{Color, Ray, Transform, Vec2, Vec3};
 use crate::texture::{self, Shaded, TexPoint, Texture};
 
@@ -171,7 +171,8 @@ impl Scene {
         }
         let m = self.material(s);
         let base = Shaded { ambient: m.ambient, diffuse: m.diffuse, specular: m.specular, n: at.n, replace_all: None };
-        let out = texture::apply(maps.iter().map(|&i| &self.textures[i]), base, &at);
+        let degamma = m.degamma.then_some(DEGAMMA);
+        let out = texture::apply(maps.iter().map(|&i| &self.textures[i]), base, &at, degamma);
         if out.n != at.n {
             let n = match to_world {
                 Some(t) => t.normal(out.n).normalize_or(s.ns),

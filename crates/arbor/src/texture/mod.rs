@@ -202,13 +202,26 @@ pub struct Shaded {
 }
 
 /// Applies `textures` in order to the terms `base` at `at`.
-pub fn apply<'a>(textures: impl IntoIterator<Item = &'a Texture>, mut base: Shaded, at: &TexPoint) -> Shaded {
+///
+/// With `degamma`, the texels of 8-bit images that give colours (not normals or heights) are display
+/// values: they are raised to that power to make them linear. High-dynamic-range images are linear
+/// already.
+pub fn apply<'a>(
+    textures: impl IntoIterator<Item = &'a Texture>,
+    mut base: Shaded,
+    at: &TexPoint,
+    degamma: Option<f32>,
+) -> Shaded {
     for t in textures {
+        let colour = || match (&t.source, degamma) {
+            (Source::Image { image, .. }, Some(g)) if image.is_8bit() => t.eval(at).powf(g),
+            _ => t.eval(at),
+        };
         match t.decal {
-            Decal::ReplaceKd => base.diffuse = t.eval(at),
-            Decal::BlendKd => base.diffuse = (base.diffuse + t.eval(at)) * 0.5,
-            Decal::ReplaceKs => base.specular = t.eval(at),
-            Decal::ReplaceAll => base.replace_all = Some(t.eval(at)),
+            Decal::ReplaceKd => base.diffuse = colour(),
+            Decal::BlendKd => base.diffuse = (base.diffuse + colour()) * 0.5,
+            Decal::ReplaceKs => base.specular = colour(),
+            Decal::ReplaceAll => base.replace_all = Some(colour()),
             Decal::ReplaceBackground => {}
             Decal::ReplaceNormal => {
                 let c = t.eval(at) * 2.0 - Color::ONE;
@@ -246,7 +259,7 @@ mod tests {
         let t = image_texture(Decal::BumpNormal, 0.5, TexImage::from_rgb8(8, 8, bytes));
         let base =
             Shaded { ambient: Color::ZERO, diffuse: Color::ONE, specular: Color::ZERO, n: Vec3::Z, replace_all: None };
-        let out = apply([&t], base, &plane_point(Vec2::new(0.3, 0.5)));
+        let out = apply([&t], base, &plane_point(Vec2::new(0.3, 0.5)), None);
         // Height k·h rises by 0.5 · 10 per unit of u: the surface z = 5u has normal (-5, 0, 1)/|.|.
         assert!(out.n.abs_diff_eq(Vec3::new(-5.0, 0.0, 1.0).normalize(), 1e-5), "{}", out.n);
         assert_eq!(out.diffuse, Color::ONE);
@@ -300,7 +313,7 @@ mod tests {
                 80.0 * std::f32::consts::TAU / w as f32 * (std::f32::consts::TAU * (x as f32 + 0.5) / w as f32).cos();
             let hv = 3.0;
             let expected = (-k * hu / a * e1 - k * hv / b * e2 + n).normalize();
-            let got = apply([&t], base, &at).n;
+            let got = apply([&t], base, &at, None).n;
             // A difference is the derivative times sin(π/32) / (π/32) = 0.9984.
             assert!(got.abs_diff_eq(expected, 2e-3), "texel ({x}, {y}): {got} vs {expected}");
         }
@@ -317,17 +330,43 @@ mod tests {
             replace_all: None,
         };
         let at = plane_point(Vec2::splat(0.5));
-        let kd = apply([&image_texture(Decal::ReplaceKd, 1.0, img())], base, &at);
+        let kd = apply([&image_texture(Decal::ReplaceKd, 1.0, img())], base, &at, None);
         assert_eq!(kd.diffuse, Color::new(1.0, 0.0, 0.2));
-        let blend = apply([&image_texture(Decal::BlendKd, 1.0, img())], base, &at);
+        let blend = apply([&image_texture(Decal::BlendKd, 1.0, img())], base, &at, None);
         assert!(blend.diffuse.abs_diff_eq(Color::new(0.75, 0.25, 0.35), 1e-6));
-        let ks = apply([&image_texture(Decal::ReplaceKs, 1.0, img())], base, &at);
+        let ks = apply([&image_texture(Decal::ReplaceKs, 1.0, img())], base, &at, None);
         assert_eq!((ks.specular, ks.diffuse), (Color::new(1.0, 0.0, 0.2), base.diffuse));
-        let all = apply([&image_texture(Decal::ReplaceAll, 1.0, img())], base, &at);
+        let all = apply([&image_texture(Decal::ReplaceAll, 1.0, img())], base, &at, None);
         assert_eq!(all.replace_all, Some(Color::new(1.0, 0.0, 0.2)));
         // A tangent-space normal of (1, 0.5, 0.6) after mapping [0, 1] to [-1, 1]: (1, 0, 0.2).
-        let normal = apply([&image_texture(Decal::ReplaceNormal, 1.0, img())], base, &at);
+        let normal = apply([&image_texture(Decal::ReplaceNormal, 1.0, img())], base, &at, None);
         assert!(normal.n.abs_diff_eq(Vec3::new(1.0, -1.0, -0.6).normalize(), 1e-6), "{}", normal.n);
+    }
+
+    #[test]
+    fn degamma_linearizes_8_bit_colour_texels_only() {
+        let base =
+            Shaded { ambient: Color::ONE, diffuse: Color::ONE, specular: Color::ONE, n: Vec3::Z, replace_all: None };
+        let at = plane_point(Vec2::splat(0.5));
+        let texel = || TexImage::from_rgb8(1, 1, vec![128, 128, 128]);
+        let kd = image_texture(Decal::ReplaceKd, 1.0, texel());
+        let shown = apply([&kd], base, &at, None).diffuse.x;
+        let linear = apply([&kd], base, &at, Some(2.2)).diffuse.x;
+        assert!((shown - 128.0 / 255.0).abs() < 1e-6 && (linear - (128.0_f32 / 255.0).powf(2.2)).abs() < 1e-6);
+        // A normal map is not a colour; a float (HDR) image is linear already.
+        let normal = image_texture(Decal::ReplaceNormal, 1.0, texel());
+        assert_eq!(apply([&normal], base, &at, Some(2.2)).n, apply([&normal], base, &at, None).n);
+        let hdr = Texture {
+            source: Source::Image {
+                image: Arc::new(TexImage::from_texels(1, 1, image::Texels::F32(vec![0.5; 3]))),
+                filter: Filter::Nearest,
+                normalizer: 1.0,
+                clamp: false,
+            },
+            decal: Decal::ReplaceKd,
+            bump_factor: 1.0,
+        };
+        assert_eq!(apply([&hdr], base, &at, Some(2.2)).diffuse, Color::splat(0.5));
     }
 
     #[test]
@@ -338,7 +377,7 @@ mod tests {
         let at = TexPoint { uv: Vec2::ZERO, p, n: Vec3::Z, dpdu: Vec3::X, dpdv: Vec3::Y, footprint: 0.0 };
         let base =
             Shaded { ambient: Color::ONE, diffuse: Color::ONE, specular: Color::ONE, n: Vec3::Z, replace_all: None };
-        let out = apply([&t], base, &at);
+        let out = apply([&t], base, &at, None);
         // The height is 2 · (noise + 1) / 2 = noise(0.7 p): its x and y slopes by differences.
         let h = 1e-3;
         let height = |q: Vec3| perlin::noise(q * scale);
