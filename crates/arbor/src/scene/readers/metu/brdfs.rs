@@ -35,7 +35,7 @@ impl Reader<'_> {
             };
             let exponent_node = self.req(n, "Exponent")?;
             let exponent = exponent_node.float(p)?;
-            if !(exponent >= 0.0) {
+            if exponent < 0.0 {
                 return Err(self.err(exponent_node, format!("BRDF {id}: negative exponent {exponent}")));
             }
             let flag = |r: &Self, name: &str| n.attr(name).map_or(Ok(false), |a| a.boolean(r.path));
