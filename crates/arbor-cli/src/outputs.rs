@@ -97,6 +97,12 @@ pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
     }
 }
 
+/// The tone mapping of the PNG beside a high-dynamic-range image `path` whose camera names none: every
+/// HDR image gets its PNG, by the course's settings ([`Tonemap::PREVIEW`]); `None` for other formats.
+pub fn hdr_preview(path: &Path) -> Option<Tonemap> {
+    arbor::image_io::is_hdr_path(path).then_some(Tonemap::PREVIEW)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,10 +138,4 @@ mod tests {
         assert_eq!(e.to_string(), want);
         assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0, "the probe file is removed");
     }
-}
-
-/// The tone mapping of the PNG beside a high-dynamic-range image `path` whose camera names none: every
-/// HDR image gets its PNG, by the course's settings ([`Tonemap::PREVIEW`]); `None` for other formats.
-pub fn hdr_preview(path: &Path) -> Option<Tonemap> {
-    arbor::image_io::is_hdr_path(path).then_some(Tonemap::PREVIEW)
 }
