@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use arbor::accel::{AccelConfig, AccelKind};
-use arbor::scene::{LightDesc, MaterialKind, MeshSource, Scene, ShapeDesc};
+use arbor::scene::{BrdfDesc, BrdfKind, LightDesc, MaterialKind, MeshSource, Scene, ShapeDesc};
 use clap::Args;
 
 use crate::Failure;
@@ -96,7 +96,10 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             MaterialKind::Dielectric { .. } => "dielectric",
             MaterialKind::Transparent { .. } => "transparent (legacy)",
         };
-        say!("material {}  {kind}", m.id);
+        match &m.brdf {
+            Some(b) => say!("material {}  {kind}, BRDF {}", m.id, brdf_name(b)),
+            None => say!("material {}  {kind}", m.id),
+        }
     }
     for o in &desc.objects {
         let what = match &o.shape {
@@ -173,4 +176,19 @@ fn list_accels() {
             say!("    {key:<key_w$}  {range:<range_w$}  {default:<default_w$}  {about}");
         }
     }
+}
+
+/// A BRDF as `info` shows it: the model, its options, the exponent.
+fn brdf_name(b: &BrdfDesc) -> String {
+    let normalized = |n: bool| if n { " normalized" } else { "" };
+    let model = match b.kind {
+        BrdfKind::OriginalPhong => "OriginalPhong".to_string(),
+        BrdfKind::ModifiedPhong { normalized: n } => format!("ModifiedPhong{}", normalized(n)),
+        BrdfKind::OriginalBlinnPhong => "OriginalBlinnPhong".to_string(),
+        BrdfKind::ModifiedBlinnPhong { normalized: n } => format!("ModifiedBlinnPhong{}", normalized(n)),
+        BrdfKind::TorranceSparrow { kd_fresnel, eta, k } => {
+            format!("TorranceSparrow (n {eta}, k {k}{})", if kd_fresnel { ", kdfresnel" } else { "" })
+        }
+    };
+    format!("{model}, exponent {}", b.exponent)
 }

@@ -103,6 +103,13 @@ fn catalogue() -> Vec<Row> {
     render("area_light_zero_normal.xml", 3, "error: area_light_zero_normal.xml:17:13: <Normal>: zero vector\n"),
     render("area_light_nan_radiance.xml", 3, "error: area_light_nan_radiance.xml:19:13: <Radiance>: non-finite number 'nan'\n"),
     render("roughness_negative.xml", 3, "error: roughness_negative.xml:21:13: Material 1: negative roughness -0.2\n"),
+    // BRDFs: a material naming a model that is not there, a model the course does not define, a negative
+    // exponent, an option that is not a boolean, Torrance-Sparrow without the index of its Fresnel term.
+    render("brdf_missing.xml", 3, "error: brdf_missing.xml:22:26: Material 1: unknown BRDF id '2'\n"),
+    render("brdf_unknown_type.xml", 3, "error: brdf_unknown_type.xml:19:9: <BRDFs>: unknown BRDF model <CookTorrance> (expected OriginalPhong, ModifiedPhong, OriginalBlinnPhong, ModifiedBlinnPhong or TorranceSparrow)\n"),
+    render("brdf_negative_exponent.xml", 3, "error: brdf_negative_exponent.xml:19:54: BRDF 1: negative exponent -5\n"),
+    render("brdf_normalized_not_boolean.xml", 3, "error: brdf_normalized_not_boolean.xml:19:36: attribute normalized: expected true or false, found 'yes'\n"),
+    render("brdf_torrance_sparrow_no_index.xml", 3, "error: brdf_torrance_sparrow_no_index.xml:22:26: Material 1: BRDF '1' (TorranceSparrow) needs a <RefractionIndex> for its Fresnel term\n"),
     render("motion_blur_nan.xml", 3, "error: motion_blur_nan.xml:29:82: <MotionBlur>: non-finite number 'nan'\n"),
     render("motion_blur_short.xml", 3, "error: motion_blur_short.xml:29:82: <MotionBlur>: expected 3 numbers, found 2\n"),
     // Indices out of range.

@@ -21,6 +21,7 @@ fn material(ambient: f32, diffuse: f32, kind: MaterialKind) -> MaterialDesc {
         diffuse: Color::splat(diffuse),
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        brdf: None,
         roughness: 0.0,
         kind,
     }

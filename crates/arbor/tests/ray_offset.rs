@@ -50,6 +50,7 @@ fn scene(objects: Vec<ObjectDesc>, rule: OffsetRule) -> Scene {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        brdf: None,
         roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });
@@ -198,6 +199,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             diffuse: Color::splat(1.0),
             specular: Color::splat(0.5),
             phong_exponent: 20.0,
+            brdf: None,
             roughness: 0.0,
             kind: MaterialKind::BlinnPhong,
         });

@@ -1,7 +1,7 @@
 //! The course scenes against their official reference images.
 //!
-//! Every scene of the 2024 XML set, the 2025 JSON sets (hw1, hw3), the 2022 hw2 and hw4 sets and the NYU
-//! bunny is rendered and compared with its reference. A scene of one sample per pixel passes when at most 0.5% of
+//! Every scene of the 2024 XML set, the 2025 JSON sets (hw1, hw3), the 2022 hw2, hw4, hw5 and hw6 BRDF
+//! sets and the NYU bunny is rendered and compared with its reference. A scene of one sample per pixel passes when at most 0.5% of
 //! its pixels differ by more than 8 levels in any channel. A scene of more samples has a reference made
 //! of the official renderer's own random numbers, which no other sampler reproduces pixel for pixel: it
 //! passes when at most 2% of its 8x8-pixel block means differ by more than 8 levels in any channel. By
@@ -326,6 +326,47 @@ fn reference_nyu_bunny() {
     let reference = dir.join("nyu-cg-assignment4/Assignment_4/img/bunny.png");
     let cases = vec![Case { scene, camera: 0, reference, cull: false }];
     check(run("NYU bunny", cases, Vec::new(), None).1);
+}
+
+/// The 2022 hw6 BRDF scenes (one sample per pixel), and the references no scene file renders (the
+/// killeroo images), listed as skipped.
+fn hw6_brdf_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
+    let root = dir.join("ceng795-2022/hw6/brdf");
+    let (cases, mut skipped) = metu_cases(&root, "xml", &[("outputs", false)]);
+    assert!(cases.len() >= 7, "only {} cases found", cases.len());
+    for png in common::scene_files(&root.join("outputs"), "png") {
+        if !cases.iter().any(|c| c.reference == png) {
+            skipped.push(format!("{} (no scene file)", png.display()));
+        }
+    }
+    (cases, skipped)
+}
+
+#[test]
+fn reference_ceng795_2022_hw6_brdf() {
+    let Some(dir) = common::scenes_dir() else { return };
+    let (cases, skipped) = hw6_brdf_2022(&dir);
+    check(run("CENG 795 2022 hw6 BRDFs", cases, skipped, None).1);
+}
+
+/// The 2019 BRDF scenes (hw5) have no references; they read without a warning, every material with
+/// its model, and render.
+#[test]
+fn reference_ceng795_2019_hw5_brdf_scenes_read_without_warnings() {
+    let Some(dir) = common::scenes_dir() else { return };
+    let scenes: Vec<_> = common::scene_files(&dir.join("ceng795-2019/inputs/hw5"), "xml")
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("brdf_")))
+        .collect();
+    assert_eq!(scenes.len(), 7);
+    for scene in scenes {
+        let desc = load_desc(&scene).unwrap_or_else(|e| panic!("{e}"));
+        assert!(desc.warnings.is_empty(), "{}: {:?}", scene.display(), desc.warnings);
+        assert!(desc.materials.iter().all(|m| m.brdf.is_some()), "{}", scene.display());
+        let scene = Scene::build(desc, &AccelConfig::default(), None).unwrap_or_else(|e| panic!("{e}"));
+        let (film, _) = render(&scene, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
+        assert!(film.pixels.iter().any(|c| c.max_element() > 0.0));
+    }
 }
 
 /// hw5 scene files that cannot reproduce their reference under any reading of the text, and why. They

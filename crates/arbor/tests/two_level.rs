@@ -44,6 +44,7 @@ fn desc(objects: Vec<ObjectDesc>) -> SceneDesc {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        brdf: None,
         roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });

@@ -171,6 +171,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
         diffuse: Color::ONE,
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        brdf: None,
         roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });

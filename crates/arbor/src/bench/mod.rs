@@ -103,6 +103,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
         diffuse: Color::splat(0.7),
         specular: Color::ZERO,
         phong_exponent: 1.0,
+        brdf: None,
         roughness: 0.0,
         kind: MaterialKind::BlinnPhong,
     });

@@ -19,7 +19,7 @@
 use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
 use crate::camera::{Camera, RayCone};
-use crate::material::{beer, blinn_phong, perturb, Material};
+use crate::material::{beer, perturb, Material};
 use crate::math::{Color, Ray, Vec2};
 use crate::sampler::Rng;
 use crate::scene::Scene;
@@ -119,6 +119,7 @@ impl<'a> Whitted<'a> {
         let mut color = if local { terms.ambient * scene.ambient } else { Color::ZERO };
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
         let shadow_origin = spawn_origin(scene.offset, &s, ng);
+        let wo = if m.brdf.is_some() { -d.normalize() } else { -d };
         for light in scene.lights.iter().filter(|_| local) {
             let Some(ls) = light.sample(s.p, ns, rng.next_2d()) else { continue };
             if ns.dot(ls.wi) <= 0.0 {
@@ -130,7 +131,7 @@ impl<'a> Whitted<'a> {
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;
             }
-            color += blinn_phong(terms, ns, ls.wi, -d) * ls.irradiance;
+            color += terms.eval_cos(ns, ls.wi, wo) * ls.irradiance;
         }
 
         if depth < scene.max_depth && m.layer.is_some() {

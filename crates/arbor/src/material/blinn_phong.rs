@@ -28,6 +28,7 @@ mod tests {
             diffuse: Color::splat(0.5),
             specular: Color::splat(0.25),
             phong_exponent: 10.0,
+            brdf: None,
             roughness: 0.0,
             layer: None,
             degamma: false,

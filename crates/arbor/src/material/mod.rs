@@ -1,12 +1,14 @@
-//! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong`]), and the
-//! perfectly specular layer that mirrors, conductors and dielectrics add ([`SpecularLayer`]), each in
-//! the file named after its scene-file `type`, made glossy by a roughness ([`perturb`]). The scene's build step makes a [`Material`] from each
-//! material of the description; nothing here knows the scene file.
+//! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong`]), or the BRDF
+//! model it names instead ([`Brdf`]), and the perfectly specular layer that mirrors, conductors and
+//! dielectrics add ([`SpecularLayer`]), each in the file named after its scene-file `type`, made glossy
+//! by a roughness ([`perturb`]). The scene's build step makes a [`Material`] from each material of the
+//! description; nothing here knows the scene file.
 //!
 //! A new kind of specular behaviour is a type in its own file implementing [`SpecularLayer`]; the
 //! integrator only asks the trait.
 
 mod blinn_phong;
+mod brdf;
 mod conductor;
 mod dielectric;
 mod glossy;
@@ -18,6 +20,7 @@ use std::fmt;
 use crate::math::{Color, Vec3};
 
 pub use blinn_phong::blinn_phong;
+pub use brdf::{Brdf, BrdfModel};
 pub use conductor::{fresnel_conductor, Conductor};
 pub use dielectric::{beer, fresnel_dielectric, refract, Dielectric};
 pub use glossy::perturb;
@@ -70,6 +73,9 @@ pub struct Material {
     pub specular: Color,
     /// Blinn-Phong exponent.
     pub phong_exponent: f32,
+    /// The BRDF that replaces the Blinn-Phong terms (with `diffuse` and `specular` as its reflectances);
+    /// `None` for Blinn-Phong.
+    pub brdf: Option<Brdf>,
     /// How far the layer's rays stray from their ideal directions ([`perturb`]); 0 for none.
     pub roughness: f32,
     /// Mirror, conductor, dielectric...; `None` for Blinn-Phong only (no secondary rays).
@@ -80,6 +86,16 @@ pub struct Material {
 }
 
 impl Material {
+    /// The fraction of the irradiance from unit `wi` reflected towards unit `wo` at unit shading normal
+    /// `n`: the BRDF times the incidence cosine, Blinn-Phong's terms for a material without a BRDF.
+    #[inline]
+    pub fn eval_cos(&self, n: Vec3, wi: Vec3, wo: Vec3) -> Color {
+        match &self.brdf {
+            None => blinn_phong(self, n, wi, wo),
+            Some(b) => b.f(self.diffuse, self.specular, wi, wo, n) * n.dot(wi).max(0.0),
+        }
+    }
+
     /// The specular lobes at a surface with unit outward normal `n` hit by unit direction `d`; none
     /// for a Blinn-Phong-only material.
     #[inline]

@@ -13,7 +13,8 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::desc::{
-    CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule, SceneDesc, ShapeDesc,
+    BrdfDesc, BrdfKind, CameraDesc, LightDesc, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, OffsetRule,
+    SceneDesc, ShapeDesc,
 };
 use super::geometry::{
     prim_count, world_box, MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape,
@@ -24,7 +25,7 @@ use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
-use crate::material::{Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent, DEGAMMA};
+use crate::material::{Brdf, BrdfModel, Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent, DEGAMMA};
 use crate::math::{Aabb, Vec3};
 use crate::texture::Decal;
 use crate::{Error, Location, Result};
@@ -136,10 +137,23 @@ fn build_material(desc: &MaterialDesc) -> Material {
         diffuse: linear(desc.diffuse),
         specular: linear(desc.specular),
         phong_exponent: desc.phong_exponent,
+        brdf: desc.brdf.as_ref().map(build_brdf),
         roughness: desc.roughness,
         layer,
         degamma: desc.degamma,
     }
+}
+
+/// The runtime BRDF of a description.
+fn build_brdf(desc: &BrdfDesc) -> Brdf {
+    let model = match desc.kind {
+        BrdfKind::OriginalPhong => BrdfModel::OriginalPhong,
+        BrdfKind::ModifiedPhong { normalized } => BrdfModel::ModifiedPhong { normalized },
+        BrdfKind::OriginalBlinnPhong => BrdfModel::OriginalBlinnPhong,
+        BrdfKind::ModifiedBlinnPhong { normalized } => BrdfModel::ModifiedBlinnPhong { normalized },
+        BrdfKind::TorranceSparrow { kd_fresnel, eta, k } => BrdfModel::TorranceSparrow { eta, k, kd_fresnel },
+    };
+    Brdf { model, exponent: desc.exponent }
 }
 
 /// The runtime light of a description.
@@ -372,6 +386,7 @@ mod tests {
             diffuse: Color::splat(0.2),
             specular: Color::splat(0.3),
             phong_exponent: 5.0,
+            brdf: None,
             roughness: 0.0,
             kind,
         };
@@ -402,6 +417,23 @@ mod tests {
         );
         let up = linear.specular_lobes(d, Vec3::Y)[0].weight;
         assert!((up.y - 0.217_637_65).abs() < 1e-6, "{up}");
+    }
+
+    #[test]
+    fn build_brdf_maps_every_model() {
+        let cases = [
+            (BrdfKind::OriginalPhong, BrdfModel::OriginalPhong),
+            (BrdfKind::ModifiedPhong { normalized: true }, BrdfModel::ModifiedPhong { normalized: true }),
+            (BrdfKind::OriginalBlinnPhong, BrdfModel::OriginalBlinnPhong),
+            (BrdfKind::ModifiedBlinnPhong { normalized: false }, BrdfModel::ModifiedBlinnPhong { normalized: false }),
+            (
+                BrdfKind::TorranceSparrow { kd_fresnel: true, eta: 0.37, k: 2.82 },
+                BrdfModel::TorranceSparrow { eta: 0.37, k: 2.82, kd_fresnel: true },
+            ),
+        ];
+        for (kind, model) in cases {
+            assert_eq!(build_brdf(&BrdfDesc { kind, exponent: 50.0 }), Brdf { model, exponent: 50.0 });
+        }
     }
 
     #[test]

@@ -12,7 +12,9 @@ use crate::math::{Color, Transform, Vec3};
 use crate::tonemap::Tonemap;
 use crate::Location;
 
+mod brdf;
 mod texture;
+pub use brdf::{BrdfDesc, BrdfKind};
 pub use texture::{DecalMode, ImageDesc, Interpolation, NoiseConversion, TextureDesc, TextureSource};
 
 /// A whole scene as described by its file.
@@ -265,6 +267,8 @@ pub struct MaterialDesc {
     pub specular: Color,
     /// Blinn-Phong exponent (1 when the file gives none).
     pub phong_exponent: f32,
+    /// The BRDF model that replaces the Blinn-Phong terms, if the material names one.
+    pub brdf: Option<BrdfDesc>,
     /// How far reflected and refracted rays stray from the ideal direction (`Roughness`); 0 is a
     /// perfect mirror or glass.
     pub roughness: f32,

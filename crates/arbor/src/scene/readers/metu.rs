@@ -18,7 +18,7 @@
 //! - an absent `MaxRecursionDepth` is 0 in XML (the 2024 official parser) and 6 in the 2025 JSON form,
 //!   whose `bunny_with_plane.png` reference shows its mirror plane with no depth given;
 //! - duplicated single-valued elements: the last one wins, with a warning;
-//! - what Arbor does not render (BRDFs, tone mapping, emission...) is one warning per
+//! - what Arbor does not render (emission, path tracing...) is one warning per
 //!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
 
 use std::collections::HashMap;
@@ -53,6 +53,7 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
         vertices: Vec::new(),
         transforms: HashMap::new(),
         materials: HashMap::new(),
+        brdfs: HashMap::new(),
         images: image_table(root),
         texture_ids: HashMap::new(),
         uvs: Vec::new(),
@@ -63,6 +64,9 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
     }
     if let Some(t) = r.one(root, "Transformations") {
         r.transformations(t)?;
+    }
+    if let Some(b) = r.one(root, "BRDFs") {
+        r.read_brdfs(b)?;
     }
     if let Some(m) = r.one(root, "Materials") {
         r.read_materials(m)?;
@@ -133,6 +137,8 @@ struct Reader<'a> {
     vertices: Vec<Vec3>,
     transforms: HashMap<String, Transform>,
     materials: HashMap<String, usize>,
+    /// `BRDFs` models by id, for the materials that name them.
+    brdfs: HashMap<String, brdfs::BrdfEntry>,
     /// `Textures/Images/Image` by id: the file name as written, for lights that name an image.
     images: HashMap<String, String>,
     /// `TextureMap` (or pre-2022 `Texture`) ids, as indices into the description's textures: one map, or
@@ -245,7 +251,6 @@ impl Reader<'_> {
         if let Some(n) = self.one(root, "BackgroundTexture") {
             self.background_texture(n);
         }
-        self.unsupported(root, "BRDFs", "BRDF models are");
         Ok(())
     }
 
@@ -311,6 +316,7 @@ impl Reader<'_> {
     }
 }
 
+mod brdfs;
 mod camera;
 mod lights;
 mod material;
@@ -320,7 +326,7 @@ mod textures;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::desc::{Lens, LightDesc, MaterialKind, ShapeDesc};
+    use crate::scene::desc::{BrdfDesc, BrdfKind, Lens, LightDesc, MaterialKind, ShapeDesc};
     use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
@@ -497,18 +503,18 @@ mod tests {
         );
         let brdf = "<Material id=\"5\" BRDF=\"1\"><AmbientReflectance>0 0 0</AmbientReflectance>\
                     <DiffuseReflectance>1 1 1</DiffuseReflectance><RefractionIndex>0.37</RefractionIndex></Material>";
-        let body = body.replace("</Materials>", &format!("{brdf}</Materials>"));
+        let body = body.replace("</Materials>", &format!("{brdf}</Materials>"))
+            + "<BRDFs><ModifiedPhong id=\"1\"><Exponent>5</Exponent></ModifiedPhong></BRDFs>";
         let d = read_xml(&body).unwrap();
         let kinds: Vec<_> = d.materials.iter().map(|m| m.kind.clone()).collect();
         let glass = MaterialKind::Transparent { eta: 1.5, transparency: Vec3::splat(0.5), mirror: Vec3::ZERO };
         let plain = MaterialKind::BlinnPhong;
         assert_eq!(kinds, [plain.clone(), plain.clone(), glass, plain.clone(), plain]);
-        // Material 5's index belongs to its BRDF, which is reported, and so is the index.
+        // Material 5's index is left to its BRDF, which (not being Torrance-Sparrow) does not read it.
         assert_eq!(
             d.warnings,
             [
                 "t.xml:1:674: Material 4: RefractionIndex 1.5 has no effect without a non-zero <Transparency>",
-                "t.xml:1:740: attribute BRDF of <Material>: BRDF models are not supported; ignored",
                 "t.xml:1:841: <RefractionIndex> in <Material> ignored (unknown or unused here)",
             ]
         );
@@ -577,6 +583,52 @@ mod tests {
             d.warnings,
             ["t.xml:1:190: <LightSphere>: emission not supported; rendered as an ordinary object (2 occurrences)"]
         );
+    }
+
+    #[test]
+    fn metu_brdfs_are_read_and_resolved_per_material() {
+        let brdfs = "<BRDFs><OriginalPhong id=\"1\"><Exponent>5</Exponent></OriginalPhong>\
+             <ModifiedPhong id=\"2\" normalized=\"true\"><Exponent>6</Exponent></ModifiedPhong>\
+             <OriginalBlinnPhong id=\"3\"><Exponent>7</Exponent></OriginalBlinnPhong>\
+             <ModifiedBlinnPhong id=\"4\"><Exponent>8</Exponent></ModifiedBlinnPhong>\
+             <TorranceSparrow id=\"5\" kdfresnel=\"true\"><Exponent>9</Exponent></TorranceSparrow>\
+             <TorranceSparrow id=\"6\"><Exponent>10</Exponent><RefractiveIndex>0.37</RefractiveIndex>\
+             </TorranceSparrow></BRDFs>";
+        let material = |id: u32, brdf: &str, extra: &str| {
+            format!(
+                "<Material id=\"{id}\" BRDF=\"{brdf}\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                 <DiffuseReflectance>1 1 1</DiffuseReflectance>{extra}</Material>"
+            )
+        };
+        let index = "<RefractionIndex>1.5</RefractionIndex><AbsorptionIndex>2</AbsorptionIndex>";
+        let materials: String = (1..=4).map(|i| material(i, &i.to_string(), "")).collect();
+        let body = format!(
+            "<Materials>{materials}{}{}{}</Materials>{brdfs}",
+            material(5, "5", index),
+            material(6, "6", ""),
+            material(7, "6", "<RefractionIndex>2.5</RefractionIndex>"),
+        );
+        let d = read_xml(&body).unwrap();
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+        let got: Vec<_> = d.materials.iter().map(|m| m.brdf.unwrap()).collect();
+        let ts = |kd_fresnel, eta, k| BrdfKind::TorranceSparrow { kd_fresnel, eta, k };
+        let want = [
+            (BrdfKind::OriginalPhong, 5.0),
+            (BrdfKind::ModifiedPhong { normalized: true }, 6.0),
+            (BrdfKind::OriginalBlinnPhong, 7.0),
+            (BrdfKind::ModifiedBlinnPhong { normalized: false }, 8.0),
+            // The material's indices (2022), else the model's own (2019), the material's first.
+            (ts(true, 1.5, 2.0), 9.0),
+            (ts(false, 0.37, 0.0), 10.0),
+            (ts(false, 2.5, 0.0), 10.0),
+        ];
+        let want: Vec<_> = want.into_iter().map(|(kind, exponent)| BrdfDesc { kind, exponent }).collect();
+        assert_eq!(got, want);
+        // An option a model does not have is reported, like any unread attribute.
+        let odd = body.replace("<OriginalPhong id=\"1\">", "<OriginalPhong id=\"1\" normalized=\"true\">");
+        let d = read_xml(&odd).unwrap();
+        assert_eq!(d.warnings.len(), 1);
+        assert!(d.warnings[0].ends_with("attribute normalized of <OriginalPhong> ignored (unknown or unused here)"));
     }
 
     #[test]

@@ -131,6 +131,7 @@ fn material(m: &Obj<'_>, i: usize, warn: &mut Vec<String>) -> Result<MaterialDes
         diffuse: m.vec3("Diffuse")?,
         specular: m.vec3("Specular")?,
         phong_exponent: m.number("Shininess")?,
+        brdf: None,
         roughness: 0.0,
         kind,
     })

@@ -79,9 +79,7 @@ impl Reader<'_> {
                 }
             }
         };
-        if let Some(a) = m.attr("BRDF") {
-            self.notes.feature(a.loc(p), "attribute BRDF of <Material>", "BRDF models are not supported; ignored");
-        }
+        let brdf = self.material_brdf(m, &id)?;
         let degamma = match m.attr("degamma").map(|a| (a, a.trimmed())) {
             None | Some((_, "false")) => false,
             Some((_, "true")) => true,
@@ -100,14 +98,14 @@ impl Reader<'_> {
             }
             None => 0.0,
         };
-        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, roughness, kind, degamma })
+        Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, brdf, roughness, kind, degamma })
     }
 
     /// A legacy opaque material's `RefractionIndex`: it has no effect (only a non-zero `Transparency`
     /// makes a legacy material refract), so it is accepted in silence where it could not matter: beside
     /// an explicit zero `Transparency` (the 2019 files' template), or when it is 1. Otherwise the file
-    /// may have meant glass, and is told. A material with a `BRDF` (Torrance-Sparrow's Fresnel term reads
-    /// the index) is left alone: its index stays reported as unused, like the BRDF itself.
+    /// may have meant glass, and is told. A material with a `BRDF` is left alone: a Torrance-Sparrow
+    /// model's Fresnel term reads the index, and any other leaves it reported as unused.
     fn opaque_refraction_index(&mut self, m: &Node, id: &str, transparency_given: bool) -> Result<()> {
         if m.attrs.iter().any(|a| a.name == "BRDF") {
             return Ok(());
