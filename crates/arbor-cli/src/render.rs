@@ -17,6 +17,7 @@ use arbor::farm::{write_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, render_sums, RenderOptions, RenderStats};
+use arbor::renderer::{PathOptions, Renderer};
 use arbor::scene::{check_limits, load_desc, parse_desc, Scene, SceneDesc, SceneLimits};
 use clap::Args;
 use serde_json::json;
@@ -54,6 +55,10 @@ pub struct RenderArgs {
     /// gives the same image on any number of threads, tiles or slices; another seed, independent noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// The integrator, overriding the scene's Renderer: whitted, or path (a camera that names no path
+    /// tracer options gets importance sampling, next event estimation and MIS).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorArg>,
     #[command(flatten)]
     pub threads: crate::threads::ThreadsArg,
     /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
@@ -213,11 +218,13 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         samples: None,
         cancel: Some(signals.cancel_flag()),
         seed: args.seed,
+        renderer: None,
     };
     let mut records = Vec::new();
     for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
+        let base = RenderOptions { renderer: args.integrator.map(|i| i.renderer(cam.renderer)), ..base.clone() };
         // The tone-mapped PNG beside a high-dynamic-range image.
         let mut extra = Vec::new();
         // A debug view is written as it is.
@@ -229,7 +236,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                     Some(p) => std::fs::read(p).map_err(|e| arbor::Error::io(p, e))?,
                     None => EXAMPLE.as_bytes().to_vec(),
                 };
-                let id = identity(&scene_bytes, &cam.id, spp, args.seed, cull, args.env.as_deref());
+                let id = identity(&scene_bytes, &cam.id, spp, args.seed, cull, args.env.as_deref(), base.renderer);
                 let window = arbor::render::crop_window(opts.crop, cam.width, cam.height);
                 crate::memory::reserve_for(cam.width, cam.height, window, true)?;
                 let bar = Progress::new(args.quiet > 0, pixels(opts.crop, cam.width, cam.height), &cam.image_name);
@@ -366,4 +373,23 @@ fn summary(
         s.mean_depth,
         args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
     );
+}
+/// `--integrator`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IntegratorArg {
+    /// Whitted-style ray tracing.
+    Whitted,
+    /// Path tracing.
+    Path,
+}
+
+impl IntegratorArg {
+    /// The renderer for a camera whose scene names `scene`: a path tracer keeps the scene's options.
+    pub fn renderer(self, scene: Renderer) -> Renderer {
+        match (self, scene) {
+            (IntegratorArg::Whitted, _) => Renderer::Whitted,
+            (IntegratorArg::Path, Renderer::PathTracing(o)) => Renderer::PathTracing(o),
+            (IntegratorArg::Path, Renderer::Whitted) => Renderer::PathTracing(PathOptions::DEFAULT),
+        }
+    }
 }

@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use arbor::camera::Camera;
+use arbor::renderer::Renderer;
 use clap::Args;
 
 use crate::Failure;
@@ -101,9 +102,18 @@ impl Slice {
 }
 
 /// The identity of a render: the scene's bytes and every command-line choice that changes pixels.
-pub fn identity(scene: &[u8], camera: &str, spp: u32, seed: u64, cull: Option<bool>, env: Option<&Path>) -> String {
+pub fn identity(
+    scene: &[u8],
+    camera: &str,
+    spp: u32,
+    seed: u64,
+    cull: Option<bool>,
+    env: Option<&Path>,
+    renderer: Option<Renderer>,
+) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let options = format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}");
+    let options =
+        format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}\0renderer={renderer:?}");
     for &b in scene.iter().chain(options.as_bytes()) {
         h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
     }
@@ -139,17 +149,18 @@ mod tests {
 
     #[test]
     fn slice_identity_is_ascii_for_any_camera_id() {
-        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, 0, None, None).is_ascii());
+        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, 0, None, None, None).is_ascii());
     }
 
     #[test]
     fn slice_identity_changes_with_what_changes_pixels() {
-        let a = identity(b"scene", "1", 4, 0, None, None);
-        assert_eq!(a, identity(b"scene", "1", 4, 0, None, None));
-        assert_ne!(a, identity(b"scene2", "1", 4, 0, None, None));
-        assert_ne!(a, identity(b"scene", "2", 4, 0, None, None));
-        assert_ne!(a, identity(b"scene", "1", 8, 0, None, None));
-        assert_ne!(a, identity(b"scene", "1", 4, 1, None, None));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, Some(true), None));
+        let a = identity(b"scene", "1", 4, 0, None, None, None);
+        assert_eq!(a, identity(b"scene", "1", 4, 0, None, None, None));
+        assert_ne!(a, identity(b"scene2", "1", 4, 0, None, None, None));
+        assert_ne!(a, identity(b"scene", "2", 4, 0, None, None, None));
+        assert_ne!(a, identity(b"scene", "1", 8, 0, None, None, None));
+        assert_ne!(a, identity(b"scene", "1", 4, 1, None, None, None));
+        assert_ne!(a, identity(b"scene", "1", 4, 0, Some(true), None, None));
+        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, Some(Renderer::Whitted)));
     }
 }

@@ -10,6 +10,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::math::{orthonormal_basis, Ray, Vec2, Vec3};
+use crate::renderer::Renderer;
 use crate::tonemap::Tonemap;
 
 /// The window `left right bottom top` on the image plane, `distance` along the gaze from the eye.
@@ -90,6 +91,8 @@ pub struct Camera {
     pub num_samples: u32,
     /// How the image is tone mapped for display; none: radiance as it is.
     pub tonemap: Option<Tonemap>,
+    /// The integrator of its image.
+    pub renderer: Renderer,
 }
 
 impl Camera {
@@ -122,6 +125,7 @@ impl Camera {
             image_name: String::new(),
             num_samples: 1,
             tonemap: None,
+            renderer: Renderer::Whitted,
         }
     }
 

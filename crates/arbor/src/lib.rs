@@ -25,6 +25,7 @@ pub mod material;
 pub mod math;
 pub mod mesh_io;
 pub mod render;
+pub mod renderer;
 pub mod sampler;
 pub mod scene;
 pub mod texture;

@@ -31,7 +31,8 @@ use crate::accum::SampleSum;
 use crate::error::Result;
 use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
-use crate::integrator::{DebugIntegrator, DebugView, Whitted};
+use crate::integrator::{DebugIntegrator, DebugView, Integrator};
+use crate::renderer::Renderer;
 use crate::sampler::{pixel_offset, Rng};
 use crate::scene::Scene;
 
@@ -57,6 +58,8 @@ pub struct RenderOptions {
     pub samples: Option<(u32, u32)>,
     /// Stop early when this becomes true (a signal handler sets it): no tile starts after that.
     pub cancel: Option<Arc<AtomicBool>>,
+    /// The integrator, overriding the camera's `Renderer` (`--integrator`).
+    pub renderer: Option<Renderer>,
     /// Picks every random choice of the render ([`crate::sampler::Rng::for_sample`]); renders with
     /// different seeds have independent noise.
     pub seed: u64,
@@ -190,7 +193,7 @@ fn trace(
     let start = Instant::now();
     let cam = &scene.cameras[camera];
     let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
-    let integrator = Whitted::new(scene, cull).with_camera(cam);
+    let integrator = Integrator::new(scene, cam, opts.renderer.unwrap_or(cam.renderer), cull);
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
     let debug = opts.debug.filter(|v| !v.shades()).map(|v| DebugIntegrator::new(scene, v, cull));
     let spp = if debug.is_some() { 1 } else { opts.spp.unwrap_or(cam.num_samples).max(1) };

@@ -73,6 +73,7 @@ fn scene(materials: Vec<MaterialDesc>, objects: Vec<ObjectDesc>, lights: Vec<Lig
         transform: Transform::IDENTITY,
         lens: None,
         tonemap: None,
+        renderer: Default::default(),
         loc: Location::file("test"),
     });
     d

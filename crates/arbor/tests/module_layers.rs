@@ -27,6 +27,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("mesh_io", 0),
     ("input", 0),
     ("tonemap", 0),
+    ("renderer", 0),
     // The description: plain data with source positions, and its limits.
     ("scene::desc", 1),
     ("scene::limits", 1),

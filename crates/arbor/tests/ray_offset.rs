@@ -221,6 +221,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             transform: Transform::IDENTITY,
             lens: None,
             tonemap: None,
+            renderer: Default::default(),
             loc: Location::file("test"),
         });
         let s = Scene::build(d, &AccelConfig::default(), None).unwrap();

@@ -88,6 +88,7 @@ pub fn framing_camera(bounds: Aabb, width: u32, height: u32) -> CameraDesc {
         transform: Transform::IDENTITY,
         lens: None,
         tonemap: None,
+        renderer: Default::default(),
         loc: Location::file("bench"),
     }
 }

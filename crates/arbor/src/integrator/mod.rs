@@ -1,8 +1,52 @@
-//! Integrators: what colour a camera ray brings back.
+//! Integrators: what colour a camera ray brings back. [`Integrator`] is the one a camera's image uses.
 
 pub mod debug;
 pub mod offset;
+mod path;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};
+pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
 pub use whitted::Whitted;
+
+use crate::accel::Hit;
+use crate::camera::Camera;
+use crate::math::{Color, Ray};
+use crate::renderer::Renderer;
+use crate::sampler::Rng;
+use crate::scene::Scene;
+
+/// The integrator of one camera's image.
+pub enum Integrator<'a> {
+    /// Whitted-style ray tracing.
+    Whitted(Whitted<'a>),
+    /// Path tracing.
+    Path(PathTracer<'a>),
+}
+
+impl<'a> Integrator<'a> {
+    /// The integrator `renderer` names, for `camera`'s rays over `scene`; `cull_backfaces` applies to
+    /// camera rays only.
+    pub fn new(scene: &'a Scene, camera: &'a Camera, renderer: Renderer, cull_backfaces: bool) -> Self {
+        match renderer {
+            Renderer::Whitted => Integrator::Whitted(Whitted::new(scene, cull_backfaces).with_camera(camera)),
+            Renderer::PathTracing(o) => Integrator::Path(PathTracer::new(scene, o, cull_backfaces).with_camera(camera)),
+        }
+    }
+
+    /// The camera ray as it is traced (culled or not).
+    pub fn camera_ray(&self, ray: &Ray) -> Ray {
+        match self {
+            Integrator::Whitted(w) => w.camera_ray(ray),
+            Integrator::Path(p) => p.camera_ray(ray),
+        }
+    }
+
+    /// Radiance along the camera ray `ray` (from [`Integrator::camera_ray`]) whose closest hit is `hit`.
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
+        match self {
+            Integrator::Whitted(w) => w.li_camera_hit(ray, hit, rng, count),
+            Integrator::Path(p) => p.li_camera_hit(ray, hit, rng, count),
+        }
+    }
+}

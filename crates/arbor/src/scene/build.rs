@@ -115,6 +115,7 @@ pub fn build_camera(desc: &CameraDesc) -> Camera {
     camera.image_name = desc.image_name.clone();
     camera.num_samples = desc.num_samples;
     camera.tonemap = desc.tonemap;
+    camera.renderer = desc.renderer;
     camera
 }
 
@@ -347,6 +348,7 @@ mod tests {
             transform: Transform::IDENTITY,
             lens: None,
             tonemap: None,
+            renderer: Default::default(),
             loc: Location::file("x.xml"),
         }
     }

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use crate::geometry::TriangleMesh;
 use crate::math::{Color, Transform, Vec3};
+use crate::renderer::Renderer;
 use crate::tonemap::Tonemap;
 use crate::Location;
 
@@ -168,6 +169,8 @@ pub struct CameraDesc {
     pub lens: Option<Lens>,
     /// Tone mapping of the image (`Tonemap`); none: radiance written as it is.
     pub tonemap: Option<Tonemap>,
+    /// The integrator (`Renderer`, `RendererParams`).
+    pub renderer: Renderer,
     /// Where the camera is defined.
     pub loc: Location,
 }

@@ -214,16 +214,6 @@ impl Reader<'_> {
         parent.required(name, self.path)
     }
 
-    /// Reports every `name` child of `parent` as an unsupported feature (`what` is the feature, as the
-    /// subject of "not supported") and marks it read.
-    fn unsupported(&mut self, parent: &Node, name: &str, what: &str) {
-        for n in parent.all(name) {
-            n.mark_subtree_used();
-            let msg = format!("{what} not supported; ignored");
-            self.notes.feature(n.loc(self.path), &format!("<{name}>"), &msg);
-        }
-    }
-
     fn globals(&mut self, root: &Node) -> Result<()> {
         let p = self.path;
         if let Some(n) = self.one(root, "BackgroundColor") {

@@ -107,6 +107,7 @@ fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc
         transform: Transform::IDENTITY,
         lens: None,
         tonemap: None,
+        renderer: Default::default(),
         loc: c.loc(at),
     })
 }

@@ -3,6 +3,7 @@
 //! transformations and its thin lens.
 
 use super::Reader;
+use crate::renderer::{PathOptions, Renderer};
 use crate::scene::desc::{CameraDesc, Lens, Window};
 use crate::scene::readers::tree::Node;
 use crate::tonemap::{Operator, Tonemap};
@@ -84,8 +85,7 @@ impl Reader<'_> {
             Some(t) => Some(self.tonemap(t, &id)?),
             None => None,
         };
-        self.unsupported(c, "Renderer", "path tracing is");
-        self.unsupported(c, "RendererParams", "path tracing is");
+        let renderer = self.renderer(c, &id)?;
         Ok(CameraDesc {
             id,
             position,
@@ -101,6 +101,7 @@ impl Reader<'_> {
             transform,
             lens,
             tonemap,
+            renderer,
             loc: c.loc(p),
         })
     }
@@ -124,6 +125,48 @@ impl Reader<'_> {
             self.notes.plain(n.loc(p), msg);
         }
         Ok(square)
+    }
+
+    /// `Renderer` (only `PathTracing`; Whitted when absent) and its `RendererParams`, any of
+    /// `NextEventEstimation`, `ImportanceSampling`, `RussianRoulette` and `MIS` (hw6).
+    fn renderer(&mut self, c: &Node, id: &str) -> Result<Renderer> {
+        let p = self.path;
+        let params = self.one(c, "RendererParams");
+        match self.one(c, "Renderer").map(|n| (n, n.trimmed())) {
+            None => {
+                if let Some(n) = params {
+                    let msg = format!("Camera {id}: RendererParams without <Renderer>PathTracing</Renderer>; ignored");
+                    self.notes.plain(n.loc(p), msg);
+                }
+                Ok(Renderer::Whitted)
+            }
+            Some((_, "PathTracing")) => {
+                let mut o = PathOptions::default();
+                for word in params.map_or("", |n| n.trimmed()).split_whitespace() {
+                    let flag = match word {
+                        "NextEventEstimation" => &mut o.next_event,
+                        "ImportanceSampling" => &mut o.importance_sampling,
+                        "RussianRoulette" => &mut o.russian_roulette,
+                        "MIS" => &mut o.mis,
+                        other => {
+                            let msg = format!(
+                                "Camera {id}: unknown RendererParams '{other}' (expected NextEventEstimation, \
+                                 ImportanceSampling, RussianRoulette or MIS)"
+                            );
+                            return Err(self.err(params.unwrap_or(c), msg));
+                        }
+                    };
+                    *flag = true;
+                }
+                if o.mis {
+                    (o.next_event, o.importance_sampling) = (true, true);
+                }
+                Ok(Renderer::PathTracing(o))
+            }
+            Some((n, other)) => {
+                Err(self.err(n, format!("Camera {id}: unknown Renderer '{other}' (expected PathTracing)")))
+            }
+        }
     }
 
     /// A `Tonemap` (hw5): `TMO` (only `Photographic`), `TMOOptions` (key value and burn-out percentage),

@@ -1,0 +1,250 @@
+//! A unidirectional path tracer (Kajiya 1986) as the course defines it (CENG 795 hw6), with pbrt's
+//! structure (Pharr, Jakob & Humphreys, *Physically Based Rendering*, 4th ed., 13.3-13.4): one path per
+//! camera sample, one bounce direction per vertex, the throughput `beta` carried along.
+//!
+//! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
+//!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
+//!   lobes, picked in proportion to its weight, as delta directions.
+//! - Light: an emitter met by a ray counts, unless next event estimation sampled it already (the
+//!   course: "discard its contribution"); with `NextEventEstimation` every light is sampled at every
+//!   vertex of a non-delta surface, with a shadow ray; with `MIS` both count, weighted by the power
+//!   heuristic (Veach 1997).
+//! - Length: at most `MaxRecursionDepth` bounces; with `RussianRoulette` the course's direct form
+//!   instead: after each bounce the path survives with probability `q = min(1, max(beta))` and is divided
+//!   by it, to a safety cap of [`MAX_BOUNCES`].
+//!
+//! Materials without a BRDF are shaded as the normalized modified Blinn-Phong model (`k_d/π` plus a
+//! lobe that conserves energy): the course's default Blinn-Phong terms are not a physical BRDF (their
+//! diffuse part reflects π times the light it gets). There is no ambient term. Invariants: every
+//! estimate is unbiased for the options given (the furnace and convergence tests check it); a sample's
+//! value depends only on its random stream.
+
+use super::offset::{shadow_ray, spawn_origin};
+use crate::accel::Hit;
+use crate::camera::Camera;
+use crate::material::{beer, Brdf, BrdfModel, Material};
+use crate::math::{orthonormal_basis, Color, Ray, Vec2, Vec3};
+use crate::renderer::PathOptions;
+use crate::sampler::Rng;
+use crate::scene::Scene;
+
+/// The longest path Russian roulette may build (a path through glass keeps its throughput).
+pub const MAX_BOUNCES: u32 = 256;
+
+/// The path tracer for one render.
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    options: PathOptions,
+    cull_backfaces: bool,
+    camera: Option<&'a Camera>,
+}
+
+impl<'a> PathTracer<'a> {
+    /// A path tracer over `scene`; `cull_backfaces` applies to camera rays only.
+    pub fn new(scene: &'a Scene, options: PathOptions, cull_backfaces: bool) -> Self {
+        PathTracer { scene, options, cull_backfaces, camera: None }
+    }
+
+    /// The path tracer for the camera rays of `camera`.
+    pub fn with_camera(self, camera: &'a Camera) -> Self {
+        PathTracer { camera: Some(camera), ..self }
+    }
+
+    /// The camera ray as it is traced: culling back faces if the render asks for it.
+    pub fn camera_ray(&self, ray: &Ray) -> Ray {
+        ray.with_culling(self.cull_backfaces)
+    }
+
+    /// Radiance (in the scene's units) along the camera ray `ray`, whose closest hit is `hit`.
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
+        *count += 1;
+        let scene = self.scene;
+        let o = self.options;
+        let (mut ray, mut hit) = (*ray, hit);
+        let mut l = Color::ZERO;
+        let mut beta = Color::ONE;
+        let mut inside: Option<Color> = None;
+        let max_bounces = if o.russian_roulette { MAX_BOUNCES } else { scene.max_depth };
+        let mut bounce = 0;
+        loop {
+            let Some(h) = hit else {
+                l += beta * self.miss(&ray, bounce);
+                break;
+            };
+            if let Some(absorption) = inside {
+                beta *= beer(absorption, h.t * ray.dir.length());
+            }
+            let mut s = scene.surface(&ray, &h);
+            let m = scene.material(&s);
+            let textured = scene.textured(&ray, &h, &mut s, Default::default());
+            if let Some(c) = textured.and_then(|t| t.replace_all) {
+                l += beta * c;
+                break;
+            }
+            let (kd, ks) = textured.map_or((m.diffuse, m.specular), |t| (t.diffuse, t.specular));
+            let d = ray.dir.normalize();
+            let wo = -d;
+            let front = d.dot(s.ng) < 0.0;
+            // Shade the side the ray arrives on.
+            let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
+            let brdf = path_brdf(m);
+            let local = front || !m.transmits();
+
+            if o.next_event && local && (kd != Color::ZERO || ks != Color::ZERO) {
+                let origin = spawn_origin(scene.offset, &s, ng);
+                for light in &scene.lights {
+                    let Some(ls) = light.sample(s.p, ns, rng.next_2d()) else { continue };
+                    let cos = ns.dot(ls.wi);
+                    if cos <= 0.0 {
+                        continue;
+                    }
+                    *count += 1;
+                    let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls);
+                    if scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
+                        continue;
+                    }
+                    l += beta * brdf.f(kd, ks, ls.wi, wo, ns) * cos * ls.irradiance;
+                }
+            }
+
+            if bounce >= max_bounces {
+                break;
+            }
+            // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
+            let next = if m.layer.is_some() {
+                let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
+                let lobes = m.specular_lobes(d, n);
+                let total: f32 = lobes.iter().map(|lb| luminance(lb.weight)).sum();
+                if total <= 0.0 {
+                    break;
+                }
+                let mut pick = rng.next_f32() * total;
+                let Some(lobe) = lobes.iter().find(|lb| {
+                    pick -= luminance(lb.weight);
+                    pick < 0.0
+                }) else {
+                    break;
+                };
+                beta *= lobe.weight * (total / luminance(lobe.weight));
+                inside = match (lobe.transmitted, front) {
+                    (false, _) => inside,
+                    (true, true) => m.interior_absorption(),
+                    (true, false) => None,
+                };
+                lobe.dir
+            } else {
+                let (wi, pdf) = if o.importance_sampling {
+                    cosine_hemisphere(ns, rng.next_2d())
+                } else {
+                    uniform_hemisphere(ns, rng.next_2d())
+                };
+                let cos = ns.dot(wi);
+                if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
+                    break;
+                }
+                beta *= brdf.f(kd, ks, wi, wo, ns) * (cos / pdf);
+                wi
+            };
+            if o.russian_roulette {
+                let q = beta.max_element().min(1.0);
+                if rng.next_f32() >= q {
+                    break;
+                }
+                beta /= q;
+            }
+            if beta == Color::ZERO {
+                break;
+            }
+            bounce += 1;
+            let origin = spawn_origin(scene.offset, &s, next);
+            ray = Ray::new(origin, next).with_time(ray.time);
+            *count += 1;
+            hit = scene.geometry.intersect(&ray, f32::INFINITY);
+        }
+        l
+    }
+
+    /// What a ray that hits nothing brings back: the environment, else the background for camera rays.
+    fn miss(&self, ray: &Ray, bounce: u32) -> Color {
+        let scene = self.scene;
+        match &scene.environment {
+            Some(env) => env.eval(ray.dir) / scene.radiance_scale,
+            None if bounce == 0 && self.camera.is_some() => scene.background,
+            None => Color::ZERO,
+        }
+    }
+}
+
+/// The BRDF the path tracer gives a material: its own, or the normalized modified Blinn-Phong model
+/// with its Phong exponent.
+fn path_brdf(m: &Material) -> Brdf {
+    m.brdf.unwrap_or(Brdf { model: BrdfModel::ModifiedBlinnPhong { normalized: true }, exponent: m.phong_exponent })
+}
+
+fn luminance(c: Color) -> f32 {
+    crate::tonemap::luminance(c).max(0.0)
+}
+
+/// A direction over the hemisphere of unit `n`, uniform in solid angle, and its pdf `1/2π`.
+pub fn uniform_hemisphere(n: Vec3, u: Vec2) -> (Vec3, f32) {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u.y;
+    (local_to_world(n, Vec3::new(r * phi.cos(), r * phi.sin(), z)), 1.0 / (2.0 * std::f32::consts::PI))
+}
+
+/// A direction over the hemisphere of unit `n` with density `cos θ / π` (Malley's method: a uniform
+/// point of the unit disc lifted to the hemisphere), and that density.
+pub fn cosine_hemisphere(n: Vec3, u: Vec2) -> (Vec3, f32) {
+    let r = u.x.sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u.y;
+    let z = (1.0 - u.x).max(0.0).sqrt();
+    (local_to_world(n, Vec3::new(r * phi.cos(), r * phi.sin(), z)), z / std::f32::consts::PI)
+}
+
+fn local_to_world(n: Vec3, v: Vec3) -> Vec3 {
+    let (a, b) = orthonormal_basis(n);
+    (a * v.x + b * v.y + n * v.z).normalize_or(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ∫ g over the sphere of directions, by the midpoint rule in (cos θ, φ).
+    fn integrate(g: impl Fn(Vec3) -> f32) -> f32 {
+        let (nz, nphi) = (400, 400);
+        let mut sum = 0.0;
+        for i in 0..nz {
+            for j in 0..nphi {
+                let z = -1.0 + 2.0 * (i as f32 + 0.5) / nz as f32;
+                let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / nphi as f32;
+                let r = (1.0 - z * z).sqrt();
+                sum += g(Vec3::new(r * phi.cos(), r * phi.sin(), z));
+            }
+        }
+        sum * 4.0 * std::f32::consts::PI / (nz * nphi) as f32
+    }
+
+    #[test]
+    fn path_hemisphere_samplers_stay_above_and_their_pdfs_integrate_to_one() {
+        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let cos_pdf = |w: Vec3| w.dot(n).max(0.0) / std::f32::consts::PI;
+        let uni_pdf = |w: Vec3| if w.dot(n) > 0.0 { 1.0 / (2.0 * std::f32::consts::PI) } else { 0.0 };
+        assert!((integrate(cos_pdf) - 1.0).abs() < 2e-3 && (integrate(uni_pdf) - 1.0).abs() < 2e-3);
+        let mut rng = Rng::for_sample(1, 2, 3, 4);
+        let (mut mean_cos_c, mut mean_cos_u) = (0.0, 0.0);
+        let k = 20_000;
+        for _ in 0..k {
+            let (c, pc) = cosine_hemisphere(n, rng.next_2d());
+            let (u, pu) = uniform_hemisphere(n, rng.next_2d());
+            assert!(c.dot(n) >= 0.0 && u.dot(n) >= 0.0);
+            assert!((pc - cos_pdf(c)).abs() < 1e-4 && (pu - uni_pdf(u)).abs() < 1e-6);
+            mean_cos_c += c.dot(n) / k as f32;
+            mean_cos_u += u.dot(n) / k as f32;
+        }
+        // E[cos θ] is 2/3 under the cosine density, 1/2 under the uniform one.
+        assert!((mean_cos_c - 2.0 / 3.0).abs() < 0.01, "{mean_cos_c}");
+        assert!((mean_cos_u - 0.5).abs() < 0.01, "{mean_cos_u}");
+    }
+}

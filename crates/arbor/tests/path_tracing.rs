@@ -1,0 +1,112 @@
+//! The path tracer against answers known without it: a white furnace (a sphere inside a uniform white
+//! environment gives back the environment's radiance times its albedo, for every sampling option), and
+//! Monte Carlo convergence (the variance of a pixel's mean over seeds falls as 1/N).
+
+use std::path::Path;
+
+use arbor::accel::AccelConfig;
+use arbor::film::Film;
+use arbor::light::environment::EnvMap;
+use arbor::math::Color;
+use arbor::render::{render, RenderOptions};
+use arbor::renderer::{PathOptions, Renderer};
+use arbor::scene::{parse_desc, Scene};
+
+/// A sphere of diffuse reflectance `kd` (no BRDF given: the path tracer's normalized Blinn-Phong, with
+/// no specular part), seen by a 16x16 camera, with `lights` and `extra` objects.
+fn scene_xml(kd: f32, lights: &str, extra: &str) -> String {
+    format!(
+        r#"<Scene><MaxRecursionDepth>4</MaxRecursionDepth><BackgroundColor>0 0 0</BackgroundColor>
+        <Cameras><Camera id="1"><Position>0 0 5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>
+        <NearPlane>-0.4 0.4 -0.4 0.4</NearPlane><NearDistance>2</NearDistance>
+        <ImageResolution>16 16</ImageResolution><ImageName>a.exr</ImageName></Camera></Cameras>
+        <Lights>{lights}</Lights>
+        <Materials><Material id="1"><AmbientReflectance>0 0 0</AmbientReflectance>
+        <DiffuseReflectance>{kd} {kd} {kd}</DiffuseReflectance><SpecularReflectance>0 0 0</SpecularReflectance>
+        </Material></Materials>
+        <VertexData>0 0 0  -3 -1.2 -3  3 -1.2 -3  3 -1.2 3  -3 -1.2 3</VertexData>
+        <Objects><Sphere id="1"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere>{extra}</Objects>
+        </Scene>"#
+    )
+}
+
+fn build(text: &str, environment: Option<EnvMap>) -> Scene {
+    let desc = parse_desc(text, Path::new("t.xml")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    Scene::build(desc, &AccelConfig::default(), environment).unwrap()
+}
+
+fn path(scene: &Scene, options: PathOptions, spp: u32, seed: u64) -> Film {
+    let opts =
+        RenderOptions { renderer: Some(Renderer::PathTracing(options)), spp: Some(spp), seed, ..Default::default() };
+    render(scene, 0, &opts, &|_, _| {}).unwrap().0
+}
+
+fn white_environment() -> EnvMap {
+    EnvMap::from_film_latlong(Film { width: 8, height: 4, pixels: vec![Color::ONE; 32] })
+}
+
+fn mean(f: &Film) -> f32 {
+    f.pixels.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / (3 * f.pixels.len()) as f32
+}
+
+/// Every option combination but MIS (which needs a light to weigh against).
+fn option_sets() -> Vec<PathOptions> {
+    let mut out = Vec::new();
+    for bits in 0..8u32 {
+        out.push(PathOptions {
+            importance_sampling: bits & 1 != 0,
+            next_event: bits & 2 != 0,
+            russian_roulette: bits & 4 != 0,
+            mis: false,
+        });
+    }
+    out
+}
+
+#[test]
+fn path_white_furnace_gives_back_the_environment_times_the_albedo() {
+    for kd in [1.0, 0.5] {
+        let scene = build(&scene_xml(kd, "", ""), Some(white_environment()));
+        for options in option_sets() {
+            let film = path(&scene, options, 64, 1);
+            // Light leaves a convex sphere after one bounce: kd times the environment's 1 where the sphere
+            // is, 1 around it. The centre 6x6 pixels see only the sphere.
+            let centre: Vec<Color> =
+                (5..11).flat_map(|y| (5..11).map(move |x| (x, y))).map(|(x, y)| film.pixels[y * 16 + x]).collect();
+            let m = centre.iter().map(|c| c.x).sum::<f32>() / centre.len() as f32;
+            // Exact but for Russian roulette's and uniform sampling's noise (about 0.01 here).
+            let exact = options.importance_sampling && !options.russian_roulette;
+            let tol = if exact { 1e-3 } else { 0.04 };
+            assert!((m - kd).abs() < tol, "{options:?}, kd {kd}: centre mean {m}");
+            if exact {
+                // Cosine sampling of a Lambertian surface makes every sample worth exactly kd.
+                assert!(centre.iter().all(|c| (c.x - kd).abs() < 1e-3), "{options:?}: {centre:?}");
+            }
+            assert!((film.pixels[0].x - 1.0).abs() < 1e-6, "the corner sees the environment");
+        }
+    }
+}
+
+#[test]
+fn path_variance_of_a_pixel_mean_falls_as_one_over_the_samples() {
+    // A point light over the sphere on a floor: direct light by next event estimation, indirect light by
+    // uniform bounces, so each sample is noisy.
+    let light = r#"<PointLight id="1"><Position>1 3 2</Position><Intensity>10000 10000 10000</Intensity></PointLight>"#;
+    let floor = r#"<Mesh id="2"><Material>1</Material><Faces>2 4 3  2 5 4</Faces></Mesh>"#;
+    let scene = build(&scene_xml(0.8, light, floor), None);
+    let options = PathOptions { next_event: true, ..Default::default() };
+    let variance = |spp: u32| {
+        let means: Vec<f32> = (1..=12).map(|seed| mean(&path(&scene, options, spp, seed))).collect();
+        let mu = means.iter().sum::<f32>() / means.len() as f32;
+        (mu, means.iter().map(|m| (m - mu).powi(2)).sum::<f32>() / (means.len() - 1) as f32)
+    };
+    let (mu4, v4) = variance(4);
+    let (mu64, v64) = variance(64);
+    assert!(v64 > 0.0 && mu64 > 0.01, "the image has light and noise: {mu64} {v64}");
+    // Sixteen times the samples: a sixteenth of the variance, within a factor of 3 either way for 12 seeds.
+    let ratio = v4 / v64;
+    assert!((16.0 / 3.0..48.0).contains(&ratio), "variance ratio {ratio} (v4 {v4}, v64 {v64})");
+    // And the means agree within their noise.
+    assert!((mu4 - mu64).abs() < 4.0 * (v4 / 12.0).sqrt(), "{mu4} vs {mu64}");
+}
