@@ -92,6 +92,7 @@ fn catalogue() -> Vec<Row> {
     render("area_light_zero_size.xml", 3, "error: area_light_zero_size.xml:18:13: AreaLight 1: Size 0 must be positive\n"),
     // Tone mapping and spot lights (hw5) out of range.
     render("material_degamma_unknown.xml", 3, "error: material_degamma_unknown.xml:19:26: Material 1: degamma must be true or false, not 'yes'\n"),
+    render("renderer_unknown_param.xml", 3, "error: renderer_unknown_param.xml:10:45: Camera 1: unknown RendererParams 'Bidirectional' (expected NextEventEstimation, ImportanceSampling, RussianRoulette or MIS)\n"),
     render("tonemap_negative_key.xml", 3, "error: tonemap_negative_key.xml:13:17: Camera 1: TMOOptions key value -0.18 must be positive\n"),
     render("tonemap_burn_out_of_range.xml", 3, "error: tonemap_burn_out_of_range.xml:13:17: Camera 1: TMOOptions burn-out percentage 101 must be in [0, 100]\n"),
     render("tonemap_gamma_zero.xml", 3, "error: tonemap_gamma_zero.xml:15:17: Camera 1: Gamma 0 must be positive\n"),

@@ -397,6 +397,41 @@ mod tests {
     }
 
     #[test]
+    fn metu_renderer_and_its_params_are_read_per_camera() {
+        use crate::renderer::{PathOptions, Renderer};
+        let read = |depth: u32, extra: &str| {
+            read_xml(&format!("<MaxRecursionDepth>{depth}</MaxRecursionDepth>{}", camera(extra)))
+        };
+        let d = read(3, "<Renderer>PathTracing</Renderer>").unwrap();
+        assert_eq!(d.cameras[0].renderer, Renderer::PathTracing(PathOptions::default()));
+        assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+        let all = "<Renderer>PathTracing</Renderer><RendererParams> NextEventEstimation ImportanceSampling \
+                   RussianRoulette</RendererParams>";
+        let want = PathOptions { next_event: true, importance_sampling: true, russian_roulette: true, mis: false };
+        assert_eq!(read(3, all).unwrap().cameras[0].renderer, Renderer::PathTracing(want));
+        // MIS brings the two samplings it weighs.
+        let mis = read(3, "<Renderer>PathTracing</Renderer><RendererParams>MIS</RendererParams>").unwrap();
+        assert_eq!(mis.cameras[0].renderer, Renderer::PathTracing(PathOptions::DEFAULT));
+        assert_eq!(read(3, "").unwrap().cameras[0].renderer, Renderer::Whitted);
+        let lone = read(3, "<RendererParams>MIS</RendererParams>").unwrap();
+        assert_eq!(lone.warnings, ["t.xml:1:259: Camera 1: RendererParams without <Renderer>PathTracing</Renderer>; ignored"]);
+        let flat = read(0, "<Renderer>PathTracing</Renderer>").unwrap();
+        assert_eq!(
+            flat.warnings,
+            ["t.xml:1:259: Camera 1: path tracing with MaxRecursionDepth 0 follows no bounce: emitters and, with \
+              NextEventEstimation, direct light only"]
+        );
+        let e = read(3, "<Renderer>PathTracing</Renderer><RendererParams>Bidirectional</RendererParams>").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:291: Camera 1: unknown RendererParams 'Bidirectional' (expected NextEventEstimation, \
+             ImportanceSampling, RussianRoulette or MIS)"
+        );
+        let e = read(3, "<Renderer>Radiosity</Renderer>").unwrap_err();
+        assert_eq!(e.to_string(), "t.xml:1:259: Camera 1: unknown Renderer 'Radiosity' (expected PathTracing)");
+    }
+
+    #[test]
     fn metu_num_samples_become_the_nearest_square_with_a_warning() {
         for (n, used) in [(1, 1), (4, 4), (9, 9), (900, 900), (2, 1), (3, 4), (10, 9), (12, 9), (13, 16), (14, 16)] {
             let d = read_xml(&camera(&format!("<NumSamples>{n}</NumSamples>"))).unwrap();

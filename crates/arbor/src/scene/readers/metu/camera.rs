@@ -140,7 +140,7 @@ impl Reader<'_> {
                 }
                 Ok(Renderer::Whitted)
             }
-            Some((_, "PathTracing")) => {
+            Some((n, "PathTracing")) => {
                 let mut o = PathOptions::default();
                 for word in params.map_or("", |n| n.trimmed()).split_whitespace() {
                     let flag = match word {
@@ -160,6 +160,13 @@ impl Reader<'_> {
                 }
                 if o.mis {
                     (o.next_event, o.importance_sampling) = (true, true);
+                }
+                if self.desc.max_depth == 0 && !o.russian_roulette {
+                    let msg = format!(
+                        "Camera {id}: path tracing with MaxRecursionDepth 0 follows no bounce: emitters and, with \
+                         NextEventEstimation, direct light only"
+                    );
+                    self.notes.plain(n.loc(p), msg);
                 }
                 Ok(Renderer::PathTracing(o))
             }
