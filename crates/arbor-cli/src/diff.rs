@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use arbor::image_io::metrics::{compare_blocks_files, compare_files};
+use arbor::image_io::noisy::compare_noisy_rgb8;
 use clap::Args;
 
 use crate::Failure;
@@ -26,6 +27,12 @@ pub struct DiffArgs {
     /// bottom edges are averaged over the pixels they have).
     #[arg(long, value_name = "K", value_parser = parse_block)]
     pub block: Option<u32>,
+    /// For a noisy (path-traced) reference: two renders at the reference's samples with different seeds.
+    /// IMAGE is then a render at four times the samples, and it passes when, on the block means (--block,
+    /// default 16), it is no farther from the reference than the two seeds are from each other plus 1
+    /// level, with every channel's mean signed difference within 2 levels.
+    #[arg(long, num_args = 2, value_names = ["SEED_A", "SEED_B"])]
+    pub noise: Option<Vec<PathBuf>>,
 }
 
 /// Parses `--block`: a whole number of pixels, at least 1.
@@ -39,6 +46,22 @@ fn parse_block(s: &str) -> Result<u32, String> {
 
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
+    if let Some(seeds) = &args.noise {
+        let (w, h, reference) = arbor::image_io::read_rgb8(&args.reference)?;
+        let mut images = Vec::new();
+        for path in [&args.image, &seeds[0], &seeds[1]] {
+            let (pw, ph, px) = arbor::image_io::read_rgb8(path)?;
+            if (pw, ph) != (w, h) {
+                let msg = format!("{} is {pw}x{ph} but the reference is {w}x{h}", path.display());
+                return Err(arbor::Error::Invalid(msg).into());
+            }
+            images.push(px);
+        }
+        let (image, a, b) = (&images[0], &images[1], &images[2]);
+        let c = compare_noisy_rgb8(&reference, image, a, b, w, h, args.block.unwrap_or(16));
+        say!("{}", c.summary());
+        return if c.passes() { Ok(()) } else { Err(Failure::TooDifferent) };
+    }
     let (share_off, what) = match args.block {
         None => {
             let c = compare_files(&args.reference, &args.image, args.threshold)?;

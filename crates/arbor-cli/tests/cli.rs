@@ -275,6 +275,25 @@ bias (image minus reference): R +0.000, G +2.400, B +0.000 levels
 }
 
 #[test]
+fn cli_diff_noise_judges_a_converged_render_by_the_seed_noise() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Reference 100; two seeds 4 levels either side of it; a converged render 1 level off, then 5.
+    ppm(tmp.path(), "ref.ppm", 4, 4, |_, _| [100; 3]);
+    ppm(tmp.path(), "a.ppm", 4, 4, |_, _| [104; 3]);
+    ppm(tmp.path(), "b.ppm", 4, 4, |_, _| [96; 3]);
+    ppm(tmp.path(), "good.ppm", 4, 4, |_, _| [101, 100, 99]);
+    ppm(tmp.path(), "far.ppm", 4, 4, |_, _| [100, 100, 109]);
+    let o = arbor(&["diff", "ref.ppm", "good.ppm", "--noise", "a.ppm", "b.ppm", "--block", "2"], tmp.path());
+    let want = "2x2 blocks: converged vs reference 0.67 levels, seed vs seed 8.00 (limit 9.00); bias +1.00 +0.00 \
+                -1.00 (limit ±2): OK\n";
+    assert_eq!((o.status.code(), stdout(&o)), (Some(0), want.to_string()));
+    let o = arbor(&["diff", "ref.ppm", "far.ppm", "--noise", "a.ppm", "b.ppm"], tmp.path());
+    let want = "16x16 blocks: converged vs reference 3.00 levels, seed vs seed 8.00 (limit 9.00); bias +0.00 +0.00 \
+                +9.00 (limit ±2): FAIL\n";
+    assert_eq!((o.status.code(), stdout(&o)), (Some(1), want.to_string()));
+}
+
+#[test]
 fn cli_diff_block_zero_is_a_usage_error() {
     let tmp = tempfile::tempdir().unwrap();
     ppm(tmp.path(), "ref.ppm", 2, 2, |_, _| [100; 3]);

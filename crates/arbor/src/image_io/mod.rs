@@ -14,6 +14,7 @@
 //! Codecs are the `image` crate's; this module only chooses formats, converts samples and handles files.
 
 pub mod metrics;
+pub mod noisy;
 mod read;
 pub(crate) mod write;
 

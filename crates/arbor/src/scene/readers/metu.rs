@@ -414,7 +414,10 @@ mod tests {
         assert_eq!(mis.cameras[0].renderer, Renderer::PathTracing(PathOptions::DEFAULT));
         assert_eq!(read(3, "").unwrap().cameras[0].renderer, Renderer::Whitted);
         let lone = read(3, "<RendererParams>MIS</RendererParams>").unwrap();
-        assert_eq!(lone.warnings, ["t.xml:1:259: Camera 1: RendererParams without <Renderer>PathTracing</Renderer>; ignored"]);
+        assert_eq!(
+            lone.warnings,
+            ["t.xml:1:259: Camera 1: RendererParams without <Renderer>PathTracing</Renderer>; ignored"]
+        );
         let flat = read(0, "<Renderer>PathTracing</Renderer>").unwrap();
         assert_eq!(
             flat.warnings,
