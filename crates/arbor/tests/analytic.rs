@@ -43,6 +43,7 @@ fn object(shape: ShapeDesc, material: usize) -> ObjectDesc {
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: Location::file("test"),
     }
 }
@@ -292,4 +293,22 @@ fn render_refuses_an_image_too_large_for_memory_before_tracing() {
     assert_eq!(e.to_string(), "not enough memory for a 4000000x4000000 image (715255.7 GiB)");
     assert!(e.is_io(), "exit 4, as the other resources the machine lacks");
     assert!(!traced.into_inner(), "refused before any tile was traced");
+}
+
+#[test]
+fn analytic_camera_ray_sees_the_radiance_of_an_emitter_on_its_front_only() {
+    // A black light mesh facing the camera shows its radiance (plus nothing: no ambient, no diffuse);
+    // turned away, its back is dark; a black light sphere shows its radiance too.
+    let black = material(0.0, 0.0, MaterialKind::BlinnPhong);
+    let emitter = |shape| ObjectDesc { emission: Some(Color::new(1.0, 2.0, 3.0)), ..object(shape, 0) };
+    let lit = |o: ObjectDesc| {
+        let s = Scene::build(scene(vec![black.clone()], vec![o], Vec::new(), 0), &AccelConfig::default(), None);
+        let s = s.unwrap();
+        assert_eq!(s.light_of(0), Some(0), "the emitter is the scene's light 0");
+        let (film, _) = render(&s, 0, &RenderOptions::default(), &|_, _| {}).unwrap();
+        film.pixels[0]
+    };
+    assert_close(lit(emitter(quad(0.0, 1.0, true))), Color::new(1.0, 2.0, 3.0));
+    assert_close(lit(emitter(quad(0.0, 1.0, false))), Color::ZERO);
+    assert_close(lit(emitter(ShapeDesc::Sphere { center: Vec3::ZERO, radius: 1.0 })), Color::new(1.0, 2.0, 3.0));
 }

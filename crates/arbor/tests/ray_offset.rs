@@ -36,6 +36,7 @@ fn object(shape: ShapeDesc, transform: Transform) -> ObjectDesc {
         transform,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: Location::file("test"),
     }
 }

@@ -311,6 +311,33 @@ fn reference_full_samples() {
     check(run("CENG 795 2022 hw2 and 2025 hw3, full samples", cases, skipped, None).1);
 }
 
+/// The hw6 direct-lighting scenes (BRDFs, point lights, `LightMesh` and `LightSphere` emitters; EXR
+/// output with a tone mapping, compared as the tone-mapped PNG and in relative radiance): the 2022 set,
+/// and the same scene files with the 2019 references beside them.
+fn hw6_direct_lighting(dir: &Path) -> (Vec<Case>, Vec<String>) {
+    let (mut cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw6/directLighting"), "xml", &[("outputs", false)]);
+    let old = dir.join("ceng795-2019/inputs/hw6/directLighting");
+    for scene in common::scene_files(&old, "xml") {
+        let desc = load_desc(&scene).unwrap_or_else(|e| panic!("{e}"));
+        for (camera, cam) in desc.cameras.iter().enumerate() {
+            let reference = reference_for(&old, &old, &scene, &cam.image_name);
+            cases.push(Case { scene: scene.clone(), camera, reference, cull: false });
+        }
+    }
+    assert!(cases.len() >= 14, "only {} cases found", cases.len());
+    (cases, skipped)
+}
+
+#[test]
+#[ignore = "fails: the official PNGs tone-map radiance in the scene's own units (0-255), where the \
+            log-average's delta is negligible, Arbor's film is in display units; and the ellipsoid is off in \
+            relative radiance; see docs/reference-results.md"]
+fn reference_ceng795_hw6_direct_lighting() {
+    let Some(dir) = common::scenes_dir() else { return };
+    let (cases, skipped) = hw6_direct_lighting(&dir);
+    check(run("CENG 795 2022 and 2019 hw6 direct lighting", cases, skipped, Some(FEW_SAMPLES)).1);
+}
+
 #[test]
 fn reference_nyu_bunny() {
     let Some(dir) = common::scenes_dir() else { return };

@@ -31,6 +31,7 @@ fn object(name: &str, shape: ShapeDesc, transform: Transform) -> ObjectDesc {
         transform,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: Location::file("test"),
     }
 }

@@ -182,6 +182,7 @@ fn watertight_nan_and_infinite_rays_hit_nothing() {
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: Location::file("test"),
     };
     desc.objects.push(object(ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh)), smooth: false }));

@@ -115,6 +115,7 @@ pub fn mesh_scene(mesh: TriangleMesh, source: &Path, camera: CameraDesc) -> Scen
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: Location::file(source),
     });
     desc

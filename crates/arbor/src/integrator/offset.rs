@@ -33,17 +33,22 @@ pub fn spawn_origin(offset: RayOffset, s: &Surface, side: Vec3) -> Vec3 {
 /// and a light set into a ceiling leaves the room below dark (project issue 15; no shared reference
 /// scene has a light closer than 0.1 to a surface, so no reference image changes with it). Under
 /// [`RayOffset::ErrorBound`] it stops at the light, exclusive (pbrt's `SpawnRayTo` stops just short of
-/// it). Lights at infinity (directional) are tested to infinity. Sampled points on emissive geometry,
-/// if they come, must stop short of their own surface instead.
+/// it). Lights at infinity (directional) are tested to infinity.
+///
+/// A sampled point on emissive geometry (`on_surface`) is on a surface the scene holds, which must not
+/// block its own light: the ray stops short of it, by `ShadowRayEpsilon`, or under
+/// [`RayOffset::ErrorBound`] by pbrt's relative `ShadowEpsilon` (1e-4 of the way).
 #[inline]
-pub fn shadow_ray(offset: RayOffset, origin: Vec3, p: Vec3, ls: &LightSample) -> (Ray, f32) {
+pub fn shadow_ray(offset: RayOffset, origin: Vec3, p: Vec3, ls: &LightSample, on_surface: bool) -> (Ray, f32) {
     if !ls.dist.is_finite() {
         return (Ray::new(origin, ls.wi), f32::INFINITY);
     }
     let to_light = p + ls.wi * ls.dist - origin;
-    let t_max = match offset {
-        RayOffset::ShadowEpsilon(epsilon) => 1.0 + epsilon / to_light.length(),
-        RayOffset::ErrorBound => 1.0,
+    let t_max = match (offset, on_surface) {
+        (RayOffset::ShadowEpsilon(epsilon), false) => 1.0 + epsilon / to_light.length(),
+        (RayOffset::ShadowEpsilon(epsilon), true) => 1.0 - epsilon / to_light.length(),
+        (RayOffset::ErrorBound, false) => 1.0,
+        (RayOffset::ErrorBound, true) => 1.0 - 1e-4,
     };
     (Ray::new(origin, to_light), t_max)
 }

@@ -13,6 +13,11 @@
 //! there a surface shows the side of its stored normal from both sides, and its shadow and mirror rays
 //! leave from that side (glass's lobes still leave on the side they go to).
 //!
+//! Emissive objects (CENG 795 hw6) are lights like the others, sampled once per light per shading point
+//! with a shadow ray that stops short of the sampled point; and camera and specular rays that hit one
+//! see its emission ([`Scene::emitted`]) on top of its own shading (black in the course's scenes). No
+//! other ray reaches an emitter here, so nothing is counted twice.
+//!
 //! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
 //! lights their [`crate::light::Light::sample`], never the description.
 
@@ -117,6 +122,7 @@ impl<'a> Whitted<'a> {
         // terms belong to its outside (the official renderers agree: scienceTree_glass.png).
         let local = front || !m.transmits();
         let mut color = if local { terms.ambient * scene.ambient } else { Color::ZERO };
+        color += scene.emitted(&s, -d);
         // Light is measured at the surface point itself; only the shadow ray starts off the surface.
         let shadow_origin = spawn_origin(scene.offset, &s, ng);
         let wo = if m.brdf.is_some() { -d.normalize() } else { -d };
@@ -126,7 +132,8 @@ impl<'a> Whitted<'a> {
                 continue;
             }
             *count += scene.shadows as u64;
-            let (shadow, t_max) = shadow_ray(scene.offset, shadow_origin, s.p, &ls);
+            let on_surface = light.object().is_some();
+            let (shadow, t_max) = shadow_ray(scene.offset, shadow_origin, s.p, &ls, on_surface);
             let shadow = shadow.with_time(ray.time);
             if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
                 continue;

@@ -1,9 +1,12 @@
 //! Square area lights (CENG 795 hw2): a `size x size` square centred at `position`, facing `normal`,
 //! emitting `radiance` from its front side. One point is sampled per shading sample; the solid angle is
 //! approximated as in the course notes, `A |n_l · w_i| / d²`, which is exact for small, distant lights.
+//! It is not geometry (no ray can hit it), so it counts as a delta light (`pdf` 0); its power is that
+//! of a one-sided Lambertian emitter, `π L A`.
 
 use super::{Light, LightSample};
 use crate::math::{orthonormal_basis, Color, Vec2, Vec3};
+use crate::tonemap::luminance;
 
 /// A square light.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,6 +27,10 @@ impl Light for AreaLight {
         let AreaLight { position, normal, size, radiance } = *self;
         sample_area(position, normal, size, radiance, p, u)
     }
+
+    fn power(&self) -> f32 {
+        std::f32::consts::PI * luminance(self.radiance) * self.size * self.size
+    }
 }
 
 fn sample_area(position: Vec3, normal: Vec3, size: f32, radiance: Color, p: Vec3, u: Vec2) -> Option<LightSample> {
@@ -39,7 +46,7 @@ fn sample_area(position: Vec3, normal: Vec3, size: f32, radiance: Color, p: Vec3
     let dist = d2.sqrt();
     let wi = to_light / dist;
     let cos_l = normal.dot(-wi).abs();
-    Some(LightSample { wi, dist, irradiance: radiance * (size * size * cos_l / d2) })
+    Some(LightSample { wi, dist, irradiance: radiance * (size * size * cos_l / d2), pdf: 0.0 })
 }
 
 #[cfg(test)]

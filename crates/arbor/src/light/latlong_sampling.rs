@@ -74,6 +74,24 @@ impl LatLongSampler {
         let pdf = p_pixel * (self.width * self.height) as f64 / (2.0 * std::f64::consts::PI.powi(2) * sin as f64);
         Some((dir, pdf as f32))
     }
+
+    /// The density per unit solid angle with which [`LatLongSampler::sample`] gives the direction `d`
+    /// (any length): the density of its pixel, through the same lookup as the map's.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        let Some(d) = d.try_normalize() else { return 0.0 };
+        let theta = d.y.clamp(-1.0, 1.0).acos();
+        let sin = theta.sin();
+        if sin <= 1e-6 {
+            return 0.0;
+        }
+        let su = 0.5 + d.x.atan2(-d.z) as f64 / (2.0 * std::f64::consts::PI);
+        let sv = theta as f64 / std::f64::consts::PI;
+        let i = ((su * self.width as f64) as usize).min(self.width - 1);
+        let j = ((sv * self.height as f64) as usize).min(self.height - 1);
+        let row = &self.cols[j * (self.width + 1)..(j + 1) * (self.width + 1)];
+        let p_pixel = (row[i + 1] - row[i]) / self.rows[self.height];
+        (p_pixel * (self.width * self.height) as f64 / (2.0 * std::f64::consts::PI.powi(2) * sin as f64)) as f32
+    }
 }
 
 /// The cell of the cumulative table `cdf` containing `x` (skipping empty cells) and the position within.
@@ -91,6 +109,17 @@ mod tests {
     use super::*;
     use crate::light::environment::EnvMap;
     use crate::math::Color;
+
+    #[test]
+    fn latlong_pdf_matches_the_density_of_the_sample() {
+        let pixels = (0..32 * 16).map(|k| Color::splat(1.0 + (k % 7) as f32 * (k % 5) as f32)).collect();
+        let s = LatLongSampler::new(&Film { width: 32, height: 16, pixels }).unwrap();
+        for k in 0..50 {
+            let u = Vec2::new((k % 10) as f32 / 10.0 + 0.037, (k / 10) as f32 / 5.0 + 0.051);
+            let (d, pdf) = s.sample(u).unwrap();
+            assert!((s.pdf(d) / pdf - 1.0).abs() < 1e-3, "{} vs {pdf} at {d}", s.pdf(d));
+        }
+    }
 
     #[test]
     fn latlong_sampling_of_a_uniform_map_is_close_to_uniform_on_the_sphere() {

@@ -4,9 +4,18 @@
 //!
 //! A new kind of light is a type in its own file implementing [`Light`]; the integrator only asks the
 //! trait.
+//!
+//! Densities are per unit solid angle at the receiving point. Lights that are a single point or
+//! direction (point, spot, directional) and the hw2 square [`AreaLight`] (not geometry: no ray can hit
+//! it) are delta lights: their samples carry `pdf == 0.0` and [`Light::pdf`] is 0 everywhere. For the
+//! others (environment, emissive objects) `irradiance == radiance · |cos θ_l| / pdf` expressed per solid
+//! angle, i.e. radiance over the sample's solid-angle density, and `pdf` is exactly what [`Light::pdf`]
+//! gives the same direction, so a path tracer can weigh light and BRDF samples against each other.
 
 mod area;
 mod directional;
+mod emissive_mesh;
+mod emissive_sphere;
 pub mod environment;
 mod latlong_sampling;
 mod point;
@@ -19,6 +28,8 @@ use crate::math::{Color, Vec2, Vec3};
 
 pub use area::AreaLight;
 pub use directional::DirectionalLight;
+pub use emissive_mesh::{EmissiveMesh, EmitterMesh};
+pub use emissive_sphere::EmissiveSphere;
 pub use point::PointLight;
 pub use spherical_directional::SphericalDirectionalLight;
 pub use spot::SpotLight;
@@ -30,8 +41,11 @@ pub struct LightSample {
     pub wi: Vec3,
     /// Distance to the light along `wi` (infinite for directional lights); shadow rays stop there.
     pub dist: f32,
-    /// Irradiance on a surface facing the light, before the cosine term.
+    /// Irradiance on a surface facing the light, before the cosine term: a Monte Carlo estimate
+    /// (radiance over `pdf` for lights with a density).
     pub irradiance: Color,
+    /// The solid-angle density with which `wi` was chosen; 0.0 for a delta light.
+    pub pdf: f32,
 }
 
 /// A light source other than the ambient light and the environment.
@@ -40,4 +54,19 @@ pub trait Light: fmt::Debug + Send + Sync {
     /// `[0,1)²`) picks the point on a light with an area, or the direction of an environment. `None` when
     /// nothing arrives (`p` on a point light, a zero direction).
     fn sample(&self, p: Vec3, n: Vec3, u: Vec2) -> Option<LightSample>;
+
+    /// The solid-angle density with which [`Light::sample`] at `p` gives the unit direction `wi` (0 for
+    /// a delta light, and for a direction that misses the light).
+    fn pdf(&self, _p: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    /// Total emitted power as a luminance, for choosing one light in proportion to its power; each
+    /// kind documents its formula.
+    fn power(&self) -> f32;
+
+    /// The scene object (index in scene-file order) this light is the emission of, if it is one.
+    fn object(&self) -> Option<u32> {
+        None
+    }
 }

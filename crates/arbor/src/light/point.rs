@@ -1,7 +1,9 @@
-//! Point lights: irradiance `intensity / d²` (the course's definition, no 4π).
+//! Point lights: irradiance `intensity / d²` (the course's definition, no 4π); a delta light, of power
+//! `4π I`.
 
 use super::{Light, LightSample};
 use crate::math::{Color, Vec2, Vec3};
+use crate::tonemap::luminance;
 
 /// Light from a point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,7 +24,11 @@ impl Light for PointLight {
             return None;
         }
         let dist = d2.sqrt();
-        Some(LightSample { wi: to_light / dist, dist, irradiance: self.intensity / d2 })
+        Some(LightSample { wi: to_light / dist, dist, irradiance: self.intensity / d2, pdf: 0.0 })
+    }
+
+    fn power(&self) -> f32 {
+        4.0 * std::f32::consts::PI * luminance(self.intensity)
     }
 }
 

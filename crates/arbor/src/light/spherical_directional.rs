@@ -5,13 +5,19 @@
 //! found by most samples; other maps are sampled uniformly on the hemisphere around the normal (density
 //! `1 / 2π`), the assignment's estimator. Not cosine-weighted: the Blinn-Phong specular term carries no
 //! cosine, so dividing by a cosine density would turn grazing directions into fireflies.
+//!
+//! [`Light::pdf`] cannot know the normal the uniform estimator sampled around: it gives `1 / 2π` for
+//! every direction, the density of any direction above that normal (the only ones that contribute).
+//! The power is pbrt-v4's for an infinite light, `4π · π r² · L̄`: the mean radiance `L̄` over the
+//! sphere of directions, crossing the disc of the scene's bounding sphere from every direction.
 
-use std::f32::consts::TAU;
+use std::f32::consts::{PI, TAU};
 
 use super::environment::EnvMap;
 use super::latlong_sampling::LatLongSampler;
 use super::{Light, LightSample};
 use crate::math::{orthonormal_basis, Vec2, Vec3};
+use crate::tonemap::luminance;
 
 /// The environment map as a light.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,6 +25,9 @@ pub struct SphericalDirectionalLight {
     map: EnvMap,
     units: f32,
     sampler: Option<LatLongSampler>,
+    /// Mean luminance over the sphere of directions, in scene units.
+    mean: f32,
+    scene_radius: f32,
 }
 
 impl SphericalDirectionalLight {
@@ -27,8 +36,30 @@ impl SphericalDirectionalLight {
     /// with what camera rays that miss see.
     pub fn new(map: EnvMap, units: f32) -> Self {
         let sampler = map.latlong().and_then(LatLongSampler::new);
-        SphericalDirectionalLight { map, units, sampler }
+        let mean = mean_luminance(&map) * units;
+        SphericalDirectionalLight { map, units, sampler, mean, scene_radius: 1.0 }
     }
+
+    /// The light with the radius of the scene's bounding sphere, for [`Light::power`].
+    pub fn with_scene_radius(self, scene_radius: f32) -> Self {
+        SphericalDirectionalLight { scene_radius, ..self }
+    }
+}
+
+/// The mean luminance of `map` over the sphere of directions, by the midpoint rule on a (θ, φ) grid.
+fn mean_luminance(map: &EnvMap) -> f32 {
+    let (nt, np) = (64, 128);
+    let (mut sum, mut weight) = (0.0f64, 0.0f64);
+    for t in 0..nt {
+        let theta = (t as f32 + 0.5) / nt as f32 * PI;
+        for p in 0..np {
+            let phi = (p as f32 + 0.5) / np as f32 * TAU;
+            let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            sum += (luminance(map.eval(d)) * theta.sin()) as f64;
+            weight += theta.sin() as f64;
+        }
+    }
+    (sum / weight) as f32
 }
 
 impl Light for SphericalDirectionalLight {
@@ -41,7 +72,7 @@ impl Light for SphericalDirectionalLight {
                 return None;
             }
             let irradiance = self.map.eval(wi) * (self.units / pdf);
-            return Some(LightSample { wi, dist: f32::INFINITY, irradiance });
+            return Some(LightSample { wi, dist: f32::INFINITY, irradiance, pdf });
         }
         let (t, b) = orthonormal_basis(n);
         // The cosine to the normal is uniform in [0, 1] for directions uniform on the hemisphere.
@@ -50,7 +81,18 @@ impl Light for SphericalDirectionalLight {
         let phi = TAU * u.y;
         let wi = (t * phi.cos() * sin + b * phi.sin() * sin + n * cos).normalize();
         let irradiance = self.map.eval(wi) * (self.units * TAU);
-        Some(LightSample { wi, dist: f32::INFINITY, irradiance })
+        Some(LightSample { wi, dist: f32::INFINITY, irradiance, pdf: 1.0 / TAU })
+    }
+
+    fn pdf(&self, _p: Vec3, wi: Vec3) -> f32 {
+        match &self.sampler {
+            Some(sampler) => sampler.pdf(wi),
+            None => 1.0 / TAU,
+        }
+    }
+
+    fn power(&self) -> f32 {
+        4.0 * PI * PI * self.scene_radius * self.scene_radius * self.mean
     }
 }
 
@@ -60,9 +102,21 @@ mod tests {
     use crate::film::Film;
     use crate::math::Color;
 
+    impl SphericalDirectionalLight {
+        fn without_importance(self) -> Self {
+            SphericalDirectionalLight { sampler: None, ..self }
+        }
+    }
+
+    #[test]
+    fn spherical_directional_light_power_is_that_of_its_mean_radiance() {
+        let light = uniform(Color::splat(0.5)).with_scene_radius(2.0);
+        assert!((light.power() / (4.0 * PI * PI * 4.0 * 127.5) - 1.0).abs() < 1e-4, "{}", light.power());
+    }
+
     fn uniform(c: Color) -> SphericalDirectionalLight {
         let film = Film { width: 4, height: 2, pixels: vec![c; 8] };
-        SphericalDirectionalLight { map: EnvMap::from_film_latlong(film), units: 255.0, sampler: None }
+        SphericalDirectionalLight::new(EnvMap::from_film_latlong(film), 255.0).without_importance()
     }
 
     #[test]

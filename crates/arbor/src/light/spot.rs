@@ -4,9 +4,12 @@
 //! falls smoothly from 1 at the fall-off edge to 0 at the coverage edge; outside the coverage cone no
 //! light arrives. (The assignment text prints `cos(falloff/2)` in the numerator, which would make the
 //! light brighten towards the coverage edge, against the text's own description of a diminishing light.)
+//! A delta light; its power is pbrt-v3's approximation, `2π I (1 - (cos falloff + cos coverage) / 2)`
+//! with the half angles.
 
 use super::{Light, LightSample, PointLight};
 use crate::math::{Color, Vec2, Vec3};
+use crate::tonemap::luminance;
 
 /// A point light emitting in a cone.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +59,11 @@ impl Light for SpotLight {
         let ls = PointLight { position: self.position, intensity: self.intensity }.sample(p, n, u)?;
         let s = self.attenuation(-ls.wi);
         (s > 0.0).then(|| LightSample { irradiance: ls.irradiance * s, ..ls })
+    }
+
+    fn power(&self) -> f32 {
+        let cone = 1.0 - 0.5 * (self.cos_falloff + self.cos_coverage);
+        std::f32::consts::TAU * luminance(self.intensity) * cone
     }
 }
 

@@ -30,6 +30,7 @@ use crate::math::{Aabb, Vec3};
 use crate::texture::Decal;
 use crate::{Error, Location, Result};
 
+mod emitters;
 mod textures;
 
 impl Scene {
@@ -41,15 +42,19 @@ impl Scene {
             Some(env) => Some(env),
             None => load_environment(&desc)?,
         };
-        let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(build_light).collect();
-        if let (Some(map), true) = (&environment, desc.environment.is_some()) {
-            let units = 1.0 / desc.radiance_scale;
-            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units)));
-        }
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
         let textures = textures::build_textures(&desc)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
+        // The radius of the bounded objects' bounding sphere, for the power of lights at infinity.
+        let bounds = geometry.top.bounds();
+        let radius = if bounds.min.cmple(bounds.max).all() { 0.5 * (bounds.max - bounds.min).length() } else { 0.0 };
+        let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(|l| build_light(l, radius)).collect();
+        if let (Some(map), true) = (&environment, desc.environment.is_some()) {
+            let units = 1.0 / desc.radiance_scale;
+            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units).with_scene_radius(radius)));
+        }
+        let (object_lights, object_emission) = emitters::build_emitters(&desc, &geometry, &mut lights)?;
         let offset = match desc.offset {
             OffsetRule::ShadowEpsilon => RayOffset::ShadowEpsilon(desc.shadow_epsilon),
             OffsetRule::ErrorBound => RayOffset::ErrorBound,
@@ -63,6 +68,8 @@ impl Scene {
             footprints: textures.iter().any(|t| t.wants_footprint()),
             textures,
             lights,
+            object_lights,
+            object_emission,
             cameras: desc.cameras.iter().map(build_camera).collect(),
             environment,
             background: desc.background,
@@ -157,14 +164,17 @@ fn build_brdf(desc: &BrdfDesc) -> Brdf {
     Brdf { model, exponent: desc.exponent }
 }
 
-/// The runtime light of a description.
-fn build_light(desc: &LightDesc) -> Box<dyn Light> {
+/// The runtime light of a description; `scene_radius` bounds the scene (for the power of a
+/// directional light).
+fn build_light(desc: &LightDesc, scene_radius: f32) -> Box<dyn Light> {
     match *desc {
         LightDesc::Point { position, intensity } => Box::new(PointLight { position, intensity }),
         LightDesc::Area { position, normal, size, radiance } => {
             Box::new(AreaLight { position, normal, size, radiance })
         }
-        LightDesc::Directional { direction, radiance } => Box::new(DirectionalLight { direction, radiance }),
+        LightDesc::Directional { direction, radiance } => {
+            Box::new(DirectionalLight { direction, radiance, scene_radius })
+        }
         LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg } => {
             match SpotLight::new(position, direction, intensity, coverage_deg, falloff_deg) {
                 Some(spot) => Box::new(spot),
@@ -441,13 +451,13 @@ mod tests {
     #[test]
     fn build_light_maps_every_kind() {
         let p = Vec3::new(0.0, 0.0, 0.0);
-        let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) });
+        let point = build_light(&LightDesc::Point { position: Vec3::Y * 2.0, intensity: Color::splat(4.0) }, 1.0);
         assert_eq!(point.sample(p, Vec3::Y, Vec2::ZERO).unwrap().irradiance, Color::ONE);
-        let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) });
+        let dir = build_light(&LightDesc::Directional { direction: -Vec3::Y, radiance: Color::splat(3.0) }, 1.0);
         assert_eq!(dir.sample(p, Vec3::Y, Vec2::ZERO).unwrap().wi, Vec3::Y);
         let area =
             LightDesc::Area { position: Vec3::Y * 4.0, normal: -Vec3::Y, size: 0.5, radiance: Color::splat(64.0) };
-        let s = build_light(&area).sample(p, Vec3::Y, Vec2::splat(0.5)).unwrap();
+        let s = build_light(&area, 1.0).sample(p, Vec3::Y, Vec2::splat(0.5)).unwrap();
         assert!((s.irradiance.x - 64.0 * 0.25 / 16.0).abs() < 1e-5);
     }
 }

@@ -339,6 +339,9 @@ pub struct ObjectDesc {
     pub motion: Vec3,
     /// Indices into [`SceneDesc::textures`] of the maps on the object (an instance names its own).
     pub textures: Vec<usize>,
+    /// The radiance the object emits (`LightMesh`, `LightSphere`; finite, non-negative), from the front
+    /// of its triangles or the outside of its sphere; `None` for an object that does not emit.
+    pub emission: Option<Color>,
     /// Where the object is defined.
     pub loc: Location,
 }

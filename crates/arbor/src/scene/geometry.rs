@@ -35,6 +35,15 @@ pub struct MeshShape {
     pub accel: Box<dyn Accel<TriangleMesh>>,
 }
 
+impl crate::light::EmitterMesh for MeshShape {
+    fn mesh(&self) -> &TriangleMesh {
+        &self.mesh
+    }
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.accel.intersect(&self.mesh, ray, f32::INFINITY)
+    }
+}
+
 /// What an object is made of.
 #[derive(Clone)]
 pub enum Shape {

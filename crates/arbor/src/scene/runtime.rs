@@ -35,8 +35,14 @@ pub struct Scene {
     pub footprints: bool,
     /// The texture that replaces the background of camera rays that miss, spanning the image plane.
     pub background_texture: Option<usize>,
-    /// Lights other than the ambient light and the environment.
+    /// Lights other than the ambient light and the environment; emissive objects' lights come last.
     pub lights: Vec<Box<dyn Light>>,
+    /// For each object, in scene-file order, the index into [`Scene::lights`] of the light it is
+    /// ([`Scene::light_of`]).
+    pub object_lights: Vec<Option<usize>>,
+    /// For each object, in scene-file order, the radiance it emits from its front side, if any
+    /// ([`Scene::emitted`]).
+    pub object_emission: Vec<Option<Color>>,
     /// One image per camera.
     pub cameras: Vec<Camera>,
     /// Seen by rays that miss, when the scene or the user names one.
@@ -96,6 +102,24 @@ impl Scene {
     #[inline]
     pub fn material(&self, s: &Surface) -> &Material {
         &self.materials[s.material]
+    }
+
+    /// The radiance leaving the surface point `s` towards `wo` (either length): its object's emission
+    /// on the side its geometric normal points to (the front of a light mesh's triangles, the outside
+    /// of a light sphere), zero on the other side and for objects that do not emit.
+    #[inline]
+    pub fn emitted(&self, s: &Surface, wo: Vec3) -> Color {
+        match self.object_emission.get(s.object as usize) {
+            Some(Some(radiance)) if wo.dot(s.ng) > 0.0 => *radiance,
+            _ => Color::ZERO,
+        }
+    }
+
+    /// The index into [`Scene::lights`] of the light that object `object` (scene-file order) is, if it
+    /// emits.
+    #[inline]
+    pub fn light_of(&self, object: u32) -> Option<usize> {
+        self.object_lights.get(object as usize).copied().flatten()
     }
 
     /// Shading data for `hit`, found on `ray`.

@@ -316,7 +316,7 @@ mod textures;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::desc::{BrdfDesc, BrdfKind, Lens, LightDesc, MaterialKind, ShapeDesc};
+    use crate::scene::desc::{BrdfDesc, BrdfKind, Lens, LightDesc, MaterialKind, MeshSource, ShapeDesc};
     use crate::scene::readers::xml;
 
     fn read_xml(body: &str) -> Result<SceneDesc> {
@@ -599,18 +599,41 @@ mod tests {
 
     #[test]
     fn metu_unsupported_feature_is_one_warning_with_a_count() {
+        let untyped = |id: u32| {
+            format!(
+                "<Material id=\"{id}\"><AmbientReflectance>0 0 0</AmbientReflectance>\
+                 <DiffuseReflectance>1 1 1</DiffuseReflectance><MirrorReflectance>1 1 1</MirrorReflectance>\
+                 </Material>"
+            )
+        };
         let body = format!(
-            "{MATERIAL}<VertexData>0 0 0</VertexData><Objects>\
-             <LightSphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <Radiance>1 1 1</Radiance></LightSphere>\
-             <LightSphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
-             <Radiance>1 1 1</Radiance></LightSphere></Objects>"
+            "<MaxRecursionDepth>6</MaxRecursionDepth><Materials>{}{}<Material id=\"3\" type=\"mirror\">\
+             <AmbientReflectance>0 0 0</AmbientReflectance><DiffuseReflectance>1 1 1</DiffuseReflectance>\
+             <MirrorReflectance>1 1 1</MirrorReflectance></Material></Materials>",
+            untyped(1),
+            untyped(2)
         );
         let d = read_xml(&body).unwrap();
-        assert_eq!(
-            d.warnings,
-            ["t.xml:1:190: <LightSphere>: emission not supported; rendered as an ordinary object (2 occurrences)"]
+        let msg = "t.xml:1:168: <MirrorReflectance>: a material without type=\"mirror\" or \"conductor\" does not \
+                   reflect (as in the official renderers); ignored (2 occurrences)";
+        assert_eq!(d.warnings, [msg]);
+    }
+
+    #[test]
+    fn metu_light_objects_are_a_mesh_and_a_sphere_with_radiance() {
+        let body = format!(
+            "{MATERIAL}<VertexData>0 0 0 1 0 0 0 1 0</VertexData><Objects>\
+             <LightSphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius>\
+             <Radiance>1 2 3</Radiance></LightSphere>\
+             <LightMesh id=\"1\"><Material>1</Material><Radiance>4 5 6</Radiance><Faces>1 2 3</Faces></LightMesh>\
+             <Sphere id=\"2\"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere></Objects>"
         );
+        let d = read_xml(&body).unwrap();
+        assert_eq!(d.warnings, Vec::<String>::new());
+        let emission: Vec<_> = d.objects.iter().map(|o| o.emission).collect();
+        assert_eq!(emission, [Some(Vec3::new(1.0, 2.0, 3.0)), Some(Vec3::new(4.0, 5.0, 6.0)), None]);
+        assert!(matches!(d.objects[0].shape, ShapeDesc::Sphere { radius: 1.0, .. }));
+        assert!(matches!(&d.objects[1].shape, ShapeDesc::Mesh { source: MeshSource::Inline(m), .. } if m.len() == 1));
     }
 
     #[test]

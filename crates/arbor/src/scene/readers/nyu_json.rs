@@ -198,6 +198,7 @@ fn object(o: &Obj<'_>, i: usize, desc: &SceneDesc, warn: &mut Vec<String>) -> Re
         transform: Transform::IDENTITY,
         motion: Vec3::ZERO,
         textures: Vec::new(),
+        emission: None,
         loc: o.loc(ty),
     })
 }

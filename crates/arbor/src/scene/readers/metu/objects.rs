@@ -1,5 +1,6 @@
 //! The `Objects` of a METU scene: meshes (inline or from a PLY file), lone triangles, spheres, planes
-//! and mesh instances, each with its material index and object-to-world transform.
+//! and mesh instances, each with its material index and object-to-world transform; and the emissive
+//! `LightMesh` and `LightSphere` (hw6), read as a mesh and a sphere with a `Radiance`.
 //!
 //! Inline faces are 1-based `VertexData` ids (plus `vertexOffset`); each mesh is compacted to the
 //! vertices it uses, renumbered from 0 in order of first use, so that a scene whose meshes share one
@@ -49,11 +50,7 @@ impl Reader<'_> {
             o.mark_used();
             let id = o.attr("id").map(|a| a.trimmed().to_string());
             let name = format!("{kind} {}", id.as_deref().unwrap_or("(no id)"));
-            if kind.starts_with("Light") {
-                let what = "emission not supported; rendered as an ordinary object";
-                self.notes.feature(o.loc(self.path), &format!("<{kind}>"), what);
-                o.child("Radiance").map(Node::mark_subtree_used);
-            }
+            let emission = if kind.starts_with("Light") { Some(self.radiance(o, &name)?) } else { None };
             let textures = self.object_textures(o, &name)?;
             let (material, shape) = if kind == "MeshInstance" {
                 let base_id =
@@ -69,7 +66,13 @@ impl Reader<'_> {
                 (material, ShapeDesc::Instance { base: 0 })
             } else {
                 let material = self.material_of(o, &name)?;
-                (material, self.shape(o, &name)?)
+                let shape = self.shape(o, &name)?;
+                if let (Some(_), ShapeDesc::Mesh { source: MeshSource::Inline(m), .. }) = (emission, &shape) {
+                    if m.indices.is_empty() {
+                        return Err(self.err(o, format!("{name}: a light mesh needs at least one triangle")));
+                    }
+                }
+                (material, shape)
             };
             let transform = self.transform_of(o)?;
             let motion = match self.one(o, "MotionBlur") {
@@ -89,7 +92,8 @@ impl Reader<'_> {
                 }
             }
             let loc = o.loc(self.path);
-            self.desc.objects.push(ObjectDesc { name, material, shape, transform, motion, textures, loc });
+            let object = ObjectDesc { name, material, shape, transform, motion, textures, emission, loc };
+            self.desc.objects.push(object);
         }
         self.resolve_instances(&pending, &ids)
     }
@@ -276,6 +280,16 @@ impl Reader<'_> {
         let msg =
             format!("{name}: texture coordinate {shown} out of range (TexCoordData has {n} pairs, numbered from 1)");
         Err(self.err(at, msg))
+    }
+
+    /// The `Radiance` of an emissive object: required, finite and not negative.
+    fn radiance(&mut self, o: &Node, name: &str) -> Result<Vec3> {
+        let r = self.req(o, "Radiance")?;
+        let radiance = r.vec3(self.path)?;
+        if radiance.cmplt(Vec3::ZERO).any() {
+            return Err(self.err(r, format!("{name}: negative Radiance {radiance}")));
+        }
+        Ok(radiance)
     }
 
     /// A child holding one vertex id (`Center`, `Point`), as the vertex.
