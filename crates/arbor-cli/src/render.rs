@@ -258,7 +258,11 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                let tonemap = if args.debug.is_some() { None } else { tonemap.or_else(|| hdr_preview(&target)) };
+                let tonemap = if args.debug.is_some() {
+                    None
+                } else {
+                    tonemap.or_else(|| hdr_preview(&target).map(|t| t.in_units(scene.radiance_scale)))
+                };
                 let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap.as_ref()))?;
                 extra = written.into_iter().filter(|p| *p != target).collect();
                 (target, stats, window)

@@ -114,7 +114,8 @@ fn cli_hdr_image_without_a_tonemap_gets_the_course_tone_mapping_beside_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stdout(&o), "Saved: ./tiny.exr\nSaved: ./tiny.png\n");
     let hdr = arbor::image_io::read_image(&tmp.path().join("tiny.exr")).unwrap();
-    let expected = (hdr.width, hdr.height, arbor::tonemap::Tonemap::PREVIEW.apply(&hdr).to_rgb8());
+    let expected =
+        (hdr.width, hdr.height, arbor::tonemap::Tonemap::PREVIEW.in_units(1.0 / 255.0).apply(&hdr).to_rgb8());
     assert_eq!(arbor::image_io::read_rgb8(&tmp.path().join("tiny.png")).unwrap(), expected);
     // A debug view is written as it is, alone.
     let debug = arbor(&["render", "-q", scene.to_str().unwrap(), "--debug", "normal", "-o", "d"], tmp.path());

@@ -15,7 +15,8 @@ use crate::math::{Color, Vec3};
 /// The luminance weights of linear sRGB (Rec. 709 primaries).
 const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 
-/// Keeps the logarithm of black pixels finite; small against any luminance a render shows.
+/// Keeps the logarithm of black pixels finite, in units of the scene's radiance; small against any
+/// luminance a render shows, but it sets how much black pixels pull the log-average down.
 const DELTA: f64 = 1e-6;
 
 /// The tone mapping operators Arbor knows (the scene file's `TMO`).
@@ -38,6 +39,10 @@ pub struct Tonemap {
     pub saturation: f32,
     /// Display gamma (positive).
     pub gamma: f32,
+    /// The film value of one unit of the scene's radiance (its radiance scale, 1/255 for the course's
+    /// files): `δ` of the log-average is a millionth of a scene unit, so that black pixels weigh as in
+    /// the course's renderer, whose films hold the scene's radiance as it is.
+    pub unit: f32,
 }
 
 /// Luminance of a linear sRGB colour.
@@ -48,13 +53,24 @@ pub fn luminance(c: Color) -> f32 {
 impl Tonemap {
     /// The tone mapping of the PNG written beside a high-dynamic-range image whose camera names none:
     /// the settings of the course's own HDR scenes (key 0.18, 1% burn-out, saturation 1, gamma 2.2).
-    pub const PREVIEW: Tonemap =
-        Tonemap { operator: Operator::Photographic, key: 0.18, burn_percent: 1.0, saturation: 1.0, gamma: 2.2 };
+    pub const PREVIEW: Tonemap = Tonemap {
+        operator: Operator::Photographic,
+        key: 0.18,
+        burn_percent: 1.0,
+        saturation: 1.0,
+        gamma: 2.2,
+        unit: 1.0,
+    };
+
+    /// The same tone mapping for a film whose one unit of scene radiance is `unit`.
+    pub fn in_units(self, unit: f32) -> Tonemap {
+        Tonemap { unit, ..self }
+    }
 
     /// The display film: every channel in `[0, 1]`, gamma applied, ready for 8-bit quantisation.
     pub fn apply(&self, film: &Film) -> Film {
         let lum: Vec<f32> = film.pixels.iter().map(|&c| sanitize(luminance(c))).collect();
-        let scale = self.key as f64 / log_average(&lum);
+        let scale = self.key as f64 / log_average(&lum, DELTA * self.unit as f64);
         let white = self.white(&lum, scale);
         let pixels = film.pixels.iter().zip(&lum).map(|(&c, &y)| self.map_pixel(c, y, scale, white)).collect();
         Film { width: film.width, height: film.height, pixels }
@@ -90,11 +106,11 @@ impl Tonemap {
 }
 
 /// `exp(mean(ln(δ + Y)))` over the pixels (the paper's equation 1).
-fn log_average(lum: &[f32]) -> f64 {
+fn log_average(lum: &[f32], delta: f64) -> f64 {
     if lum.is_empty() {
         return 1.0;
     }
-    let sum: f64 = lum.iter().map(|&y| (DELTA + y as f64).ln()).sum();
+    let sum: f64 = lum.iter().map(|&y| (delta + y as f64).ln()).sum();
     (sum / lum.len() as f64).exp()
 }
 
@@ -117,11 +133,23 @@ mod tests {
     }
 
     fn photographic(key: f32, burn_percent: f32, saturation: f32, gamma: f32) -> Tonemap {
-        Tonemap { operator: Operator::Photographic, key, burn_percent, saturation, gamma }
+        Tonemap { operator: Operator::Photographic, key, burn_percent, saturation, gamma, unit: 1.0 }
     }
 
     fn close(a: f32, b: f64) -> bool {
         (a as f64 - b).abs() < 1e-5
+    }
+
+    #[test]
+    fn tonemap_in_units_maps_a_scaled_film_as_the_film_in_scene_units() {
+        // Black pixels pull the log-average down by ln(δ): δ is a millionth of a scene unit, so a film
+        // holding radiance / 255 maps as the radiance itself would, and not without its unit.
+        let scene = vec![Color::ZERO, Color::ZERO, Color::splat(0.5), Color::new(2.0, 1.0, 0.5), Color::splat(9.0)];
+        let film_of = |k: f32| film(scene.iter().map(|&c| c * k).collect());
+        let tm = photographic(0.18, 0.0, 1.0, 2.2);
+        let want = tm.apply(&film_of(1.0)).to_rgb8();
+        assert_eq!(tm.in_units(1.0 / 255.0).apply(&film_of(1.0 / 255.0)).to_rgb8(), want);
+        assert_ne!(tm.apply(&film_of(1.0 / 255.0)).to_rgb8(), want);
     }
 
     #[test]

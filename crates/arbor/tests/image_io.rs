@@ -366,10 +366,10 @@ fn write_into_a_read_only_folder_names_the_target_not_the_temporary() {
 #[test]
 fn write_outputs_hdr_image_gets_a_tone_mapped_png_beside() {
     use arbor::image_io::write_outputs;
-    use arbor::tonemap::{Operator, Tonemap};
+    use arbor::tonemap::Tonemap;
     let dir = tempfile::tempdir().unwrap();
     let film = Film { width: 2, height: 1, pixels: vec![Color::new(0.5, 2.0, 40.0), Color::splat(3.0)] };
-    let tm = Tonemap { operator: Operator::Photographic, key: 0.18, burn_percent: 1.0, saturation: 1.0, gamma: 2.2 };
+    let tm = Tonemap::PREVIEW;
     for ext in ["exr", "hdr"] {
         let path = dir.path().join(format!("out.{ext}"));
         let written = write_outputs(&path, &film, Some(&tm)).unwrap();

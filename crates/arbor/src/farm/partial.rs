@@ -9,7 +9,8 @@
 //!   change pixels), `arbor.camera`, `arbor.spp` (samples per pixel of the full image),
 //!   `arbor.sampleStart` and `arbor.sampleEnd` (the samples held, `start..end`), `arbor.scale` (radiance
 //!   scale applied at the end), and for a camera with a tone mapping `arbor.tonemap` (the operator) with
-//!   `arbor.tonemapKey`, `arbor.tonemapBurn`, `arbor.tonemapSaturation` and `arbor.tonemapGamma`, so that
+//!   `arbor.tonemapKey`, `arbor.tonemapBurn`, `arbor.tonemapSaturation`, `arbor.tonemapGamma` and
+//!   `arbor.tonemapUnit`, so that
 //!   the merged image is written as the single-process render writes it.
 //!
 //! Written atomically like every image; read back with every field checked, errors naming the file.
@@ -38,8 +39,8 @@ pub struct Partial {
 }
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
-const TONEMAP_FIELDS: [&str; 4] =
-    ["arbor.tonemapKey", "arbor.tonemapBurn", "arbor.tonemapSaturation", "arbor.tonemapGamma"];
+const TONEMAP_FIELDS: [&str; 5] =
+    ["arbor.tonemapKey", "arbor.tonemapBurn", "arbor.tonemapSaturation", "arbor.tonemapGamma", "arbor.tonemapUnit"];
 
 /// Writes `part` to `path` (atomically: a temporary file renamed over the target).
 pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
@@ -67,7 +68,7 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
     if let Some(t) = &part.tonemap {
         let Operator::Photographic = t.operator;
         attrs.other.insert(Text::from("arbor.tonemap"), text("Photographic"));
-        for (key, v) in TONEMAP_FIELDS.iter().zip([t.key, t.burn_percent, t.saturation, t.gamma]) {
+        for (key, v) in TONEMAP_FIELDS.iter().zip([t.key, t.burn_percent, t.saturation, t.gamma, t.unit]) {
             attrs.other.insert(Text::from(*key), AttributeValue::F32(v));
         }
     }
@@ -123,9 +124,9 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
     let tonemap = match text("arbor.tonemap").as_deref() {
         None => None,
         Some("Photographic") => {
-            let [key, burn_percent, saturation, gamma] = [0, 1, 2, 3].map(|i| float(TONEMAP_FIELDS[i]));
-            let (key, burn_percent, saturation, gamma) = (key?, burn_percent?, saturation?, gamma?);
-            Some(Tonemap { operator: Operator::Photographic, key, burn_percent, saturation, gamma })
+            let [key, burn_percent, saturation, gamma, unit] = [0, 1, 2, 3, 4].map(|i| float(TONEMAP_FIELDS[i]));
+            let (key, burn_percent, saturation, gamma, unit) = (key?, burn_percent?, saturation?, gamma?, unit?);
+            Some(Tonemap { operator: Operator::Photographic, key, burn_percent, saturation, gamma, unit })
         }
         Some(other) => return Err(bad(format!("unknown tone mapping operator '{other}' in arbor.tonemap"))),
     };

@@ -5,10 +5,11 @@
 //! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
 //!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
 //!   lobes, picked in proportion to its weight, as delta directions.
-//! - Light: an emitter met by a ray counts, unless next event estimation sampled it already (the
-//!   course: "discard its contribution"); with `NextEventEstimation` every light is sampled at every
-//!   vertex of a non-delta surface, with a shadow ray; with `MIS` both count, weighted by the power
-//!   heuristic (Veach 1997).
+//! - Light: an emitter (or the environment) met by a ray counts, unless next event estimation sampled it
+//!   already (the course: "discard its contribution"); with `NextEventEstimation` one light is sampled
+//!   at every vertex of a non-delta surface, chosen in proportion to its power, with a shadow ray; with
+//!   `MIS` both count, weighted by the power heuristic (Veach 1997). After a delta lobe, met light
+//!   always counts in full (no light sample could have found it).
 //! - Length: at most `MaxRecursionDepth` bounces; with `RussianRoulette` the course's direct form
 //!   instead: after each bounce the path survives with probability `q = min(1, max(beta))` and is divided
 //!   by it, to a safety cap of [`MAX_BOUNCES`].
@@ -37,12 +38,51 @@ pub struct PathTracer<'a> {
     options: PathOptions,
     cull_backfaces: bool,
     camera: Option<&'a Camera>,
+    /// Probability of choosing each light for a light sample: its share of the total power.
+    pick: Vec<f32>,
 }
 
 impl<'a> PathTracer<'a> {
     /// A path tracer over `scene`; `cull_backfaces` applies to camera rays only.
     pub fn new(scene: &'a Scene, options: PathOptions, cull_backfaces: bool) -> Self {
-        PathTracer { scene, options, cull_backfaces, camera: None }
+        let powers: Vec<f32> = scene.lights.iter().map(|l| l.power().max(0.0)).collect();
+        let total: f32 = powers.iter().sum();
+        let pick = if total > 0.0 && total.is_finite() {
+            powers.iter().map(|p| p / total).collect()
+        } else {
+            vec![1.0 / scene.lights.len().max(1) as f32; scene.lights.len()]
+        };
+        PathTracer { scene, options, cull_backfaces, camera: None, pick }
+    }
+
+    /// A light chosen in proportion to its power by `u` in [0, 1), and the probability of that choice.
+    fn choose_light(&self, u: f32) -> Option<(usize, f32)> {
+        let mut rest = u;
+        let last = self.pick.iter().rposition(|&p| p > 0.0)?;
+        for (i, &p) in self.pick.iter().enumerate() {
+            if rest < p || i == last {
+                return Some((i, p));
+            }
+            rest -= p;
+        }
+        None
+    }
+
+    /// The weight of light met by a bounce whose direction had density `bsdf_pdf`, when light `light`
+    /// could also have been sampled towards it from `from`: 1 without next event estimation, 0 with it,
+    /// the power heuristic with MIS.
+    fn met_light_weight(&self, light: Option<usize>, from: Vec3, dir: Vec3, bsdf_pdf: f32) -> f32 {
+        let o = self.options;
+        match light {
+            _ if !o.next_event => 1.0,
+            Some(i) if o.mis => {
+                let light_pdf = self.pick[i] * self.scene.lights[i].pdf(from, dir);
+                power_heuristic(bsdf_pdf, light_pdf)
+            }
+            Some(_) => 0.0,
+            // Light no sample could choose (an environment given on the command line only).
+            None => 1.0,
+        }
     }
 
     /// The path tracer for the camera rays of `camera`.
@@ -64,11 +104,17 @@ impl<'a> PathTracer<'a> {
         let mut l = Color::ZERO;
         let mut beta = Color::ONE;
         let mut inside: Option<Color> = None;
+        // The last bounce: a delta lobe (or the camera ray) meets light in full; otherwise the point it
+        // left from and its direction's density, for the weight of the light it meets.
+        let mut last: Option<(Vec3, f32)> = None;
         let max_bounces = if o.russian_roulette { MAX_BOUNCES } else { scene.max_depth };
         let mut bounce = 0;
         loop {
             let Some(h) = hit else {
-                l += beta * self.miss(&ray, bounce);
+                let w = last.map_or(1.0, |(from, pdf)| {
+                    self.met_light_weight(scene.environment_light, from, ray.dir.normalize(), pdf)
+                });
+                l += beta * self.miss(&ray, bounce) * w;
                 break;
             };
             if let Some(absorption) = inside {
@@ -76,6 +122,13 @@ impl<'a> PathTracer<'a> {
             }
             let mut s = scene.surface(&ray, &h);
             let m = scene.material(&s);
+            let emitted = scene.emitted(&s, -ray.dir);
+            if emitted != Color::ZERO {
+                let w = last.map_or(1.0, |(from, pdf)| {
+                    self.met_light_weight(scene.light_of(s.object), from, ray.dir.normalize(), pdf)
+                });
+                l += beta * emitted * w;
+            }
             let textured = scene.textured(&ray, &h, &mut s, Default::default());
             if let Some(c) = textured.and_then(|t| t.replace_all) {
                 l += beta * c;
@@ -90,20 +143,26 @@ impl<'a> PathTracer<'a> {
             let brdf = path_brdf(m);
             let local = front || !m.transmits();
 
-            if o.next_event && local && (kd != Color::ZERO || ks != Color::ZERO) {
-                let origin = spawn_origin(scene.offset, &s, ng);
-                for light in &scene.lights {
-                    let Some(ls) = light.sample(s.p, ns, rng.next_2d()) else { continue };
-                    let cos = ns.dot(ls.wi);
-                    if cos <= 0.0 {
-                        continue;
+            // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
+            let (pick, u) = (rng.next_f32(), rng.next_2d());
+            if o.next_event && local && m.layer.is_none() && (kd != Color::ZERO || ks != Color::ZERO) {
+                if let Some((i, chosen)) = self.choose_light(pick) {
+                    let light = &scene.lights[i];
+                    if let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) {
+                        *count += 1;
+                        let origin = spawn_origin(scene.offset, &s, ng);
+                        let on_surface = light.object().is_some();
+                        let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, on_surface);
+                        if !scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
+                            let w = if o.mis && ls.pdf > 0.0 {
+                                power_heuristic(chosen * ls.pdf, self.bounce_pdf(ns, ls.wi))
+                            } else {
+                                1.0
+                            };
+                            let f = brdf.f(kd, ks, ls.wi, wo, ns) * ns.dot(ls.wi);
+                            l += beta * f * ls.irradiance * (w / chosen);
+                        }
                     }
-                    *count += 1;
-                    let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls);
-                    if scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
-                        continue;
-                    }
-                    l += beta * brdf.f(kd, ks, ls.wi, wo, ns) * cos * ls.irradiance;
                 }
             }
 
@@ -126,6 +185,7 @@ impl<'a> PathTracer<'a> {
                     break;
                 };
                 beta *= lobe.weight * (total / luminance(lobe.weight));
+                last = None;
                 inside = match (lobe.transmitted, front) {
                     (false, _) => inside,
                     (true, true) => m.interior_absorption(),
@@ -143,6 +203,7 @@ impl<'a> PathTracer<'a> {
                     break;
                 }
                 beta *= brdf.f(kd, ks, wi, wo, ns) * (cos / pdf);
+                last = Some((s.p, pdf));
                 wi
             };
             if o.russian_roulette {
@@ -164,6 +225,16 @@ impl<'a> PathTracer<'a> {
         l
     }
 
+    /// The density of a bounce direction `wi` about the shading normal `n`.
+    fn bounce_pdf(&self, n: Vec3, wi: Vec3) -> f32 {
+        let cos = n.dot(wi);
+        match () {
+            _ if cos <= 0.0 => 0.0,
+            _ if self.options.importance_sampling => cos / std::f32::consts::PI,
+            _ => 1.0 / (2.0 * std::f32::consts::PI),
+        }
+    }
+
     /// What a ray that hits nothing brings back: the environment, else the background for camera rays.
     fn miss(&self, ray: &Ray, bounce: u32) -> Color {
         let scene = self.scene;
@@ -179,6 +250,18 @@ impl<'a> PathTracer<'a> {
 /// with its Phong exponent.
 fn path_brdf(m: &Material) -> Brdf {
     m.brdf.unwrap_or(Brdf { model: BrdfModel::ModifiedBlinnPhong { normalized: true }, exponent: m.phong_exponent })
+}
+
+/// Veach's power heuristic (β = 2) for a sample of density `a` against another technique's `b`.
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 fn luminance(c: Color) -> f32 {

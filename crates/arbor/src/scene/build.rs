@@ -50,8 +50,10 @@ impl Scene {
         let bounds = geometry.top.bounds();
         let radius = if bounds.min.cmple(bounds.max).all() { 0.5 * (bounds.max - bounds.min).length() } else { 0.0 };
         let mut lights: Vec<Box<dyn Light>> = desc.lights.iter().map(|l| build_light(l, radius)).collect();
+        let mut environment_light = None;
         if let (Some(map), true) = (&environment, desc.environment.is_some()) {
             let units = 1.0 / desc.radiance_scale;
+            environment_light = Some(lights.len());
             lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units).with_scene_radius(radius)));
         }
         let (object_lights, object_emission) = emitters::build_emitters(&desc, &geometry, &mut lights)?;
@@ -68,9 +70,19 @@ impl Scene {
             footprints: textures.iter().any(|t| t.wants_footprint()),
             textures,
             lights,
+            environment_light,
             object_lights,
             object_emission,
-            cameras: desc.cameras.iter().map(build_camera).collect(),
+            // Tone mapping sees the film in the scene's radiance units (its log-average's δ is in them).
+            cameras: desc
+                .cameras
+                .iter()
+                .map(|c| {
+                    let mut camera = build_camera(c);
+                    camera.tonemap = c.tonemap.map(|t| t.in_units(desc.radiance_scale));
+                    camera
+                })
+                .collect(),
             environment,
             background: desc.background,
             ambient: desc.ambient,

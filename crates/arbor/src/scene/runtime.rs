@@ -37,6 +37,9 @@ pub struct Scene {
     pub background_texture: Option<usize>,
     /// Lights other than the ambient light and the environment; emissive objects' lights come last.
     pub lights: Vec<Box<dyn Light>>,
+    /// The index into [`Scene::lights`] of the environment map's light, when the scene names one (an
+    /// environment given only on the command line lights the misses without being sampled).
+    pub environment_light: Option<usize>,
     /// For each object, in scene-file order, the index into [`Scene::lights`] of the light it is
     /// ([`Scene::light_of`]).
     pub object_lights: Vec<Option<usize>>,

@@ -114,16 +114,6 @@ impl Node {
     pub fn mark_used(&self) {
         self.used.set(true);
     }
-    /// Marks the element and everything in it as read (for what is reported once as unsupported).
-    pub fn mark_subtree_used(&self) {
-        self.mark_used();
-        for a in &self.attrs {
-            a.used.set(true);
-        }
-        for c in &self.children {
-            c.mark_subtree_used();
-        }
-    }
     /// The children called `name`, in file order; all of them count as read.
     pub fn all<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a Node> + 'a {
         self.children.iter().filter(move |c| c.name == name).inspect(|c| c.mark_used())

@@ -217,7 +217,7 @@ impl Reader<'_> {
             return Err(self.err(gamma_node.unwrap_or(t), format!("Camera {id}: Gamma {gamma} must be positive")));
         }
         t.mark_used();
-        Ok(Tonemap { operator, key, burn_percent, saturation, gamma })
+        Ok(Tonemap { operator, key, burn_percent, saturation, gamma, unit: 1.0 })
     }
 
     /// The thin lens of `FocusDistance` `f` and `ApertureSize` `a`; none (a pinhole) when the aperture
