@@ -144,7 +144,7 @@ mod tests {
     fn tonemap_in_units_maps_a_scaled_film_as_the_film_in_scene_units() {
         // Black pixels pull the log-average down by ln(δ): δ is a millionth of a scene unit, so a film
         // holding radiance / 255 maps as the radiance itself would, and not without its unit.
-        let scene = vec![Color::ZERO, Color::ZERO, Color::splat(0.5), Color::new(2.0, 1.0, 0.5), Color::splat(9.0)];
+        let scene = [Color::ZERO, Color::ZERO, Color::splat(0.5), Color::new(2.0, 1.0, 0.5), Color::splat(9.0)];
         let film_of = |k: f32| film(scene.iter().map(|&c| c * k).collect());
         let tm = photographic(0.18, 0.0, 1.0, 2.2);
         let want = tm.apply(&film_of(1.0)).to_rgb8();

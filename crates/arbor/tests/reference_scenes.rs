@@ -325,17 +325,33 @@ fn hw6_direct_lighting(dir: &Path) -> (Vec<Case>, Vec<String>) {
         }
     }
     assert!(cases.len() >= 14, "only {} cases found", cases.len());
-    (cases, skipped)
+    for (scene, why) in HW6_DIRECT_EXCLUDED {
+        println!("EXCLUDED {scene}: {why}");
+    }
+    let excluded =
+        |c: &Case| HW6_DIRECT_EXCLUDED.iter().any(|(name, _)| c.scene.file_name().is_some_and(|f| f == *name));
+    (cases.into_iter().filter(|c| !excluded(c)).collect(), skipped)
 }
 
+/// hw6 direct-lighting scenes left out, with what was measured.
+const HW6_DIRECT_EXCLUDED: &[(&str, &str)] = &[(
+    "cornellbox_jaroslav_glossy_area_ellipsoid.xml",
+    "its LightSphere scaled 5 1 1: 73.7% of 8x8 blocks off at 100 spp, walls darker than the reference; Arbor's \
+     ellipsoid light agrees with brute-force hemisphere sampling of the same ellipsoid within 3% at three \
+     points, so the reference's light is not the ellipsoid's radiance integrated (its renderer's sampling of a \
+     transformed sphere light is not known)",
+)];
+
+/// At every sample: at 16 of 100, one light sample per pixel sample of a large emitter leaves 8x8 block
+/// means 8-10% off by noise alone (the same scenes are 0.1-1.8% off at 100).
 #[test]
-#[ignore = "fails: the official PNGs tone-map radiance in the scene's own units (0-255), where the \
-            log-average's delta is negligible, Arbor's film is in display units; and the ellipsoid is off in \
-            relative radiance; see docs/reference-results.md"]
+#[ignore = "issue 17 open: the tone-mapped PNGs match at 100 spp (0-1.8% of blocks), but the EXRs of the two \
+            ceiling-light scenes are 2.1-3.1% of blocks off in relative radiance (limit 2%); \
+            see docs/reference-results.md"]
 fn reference_ceng795_hw6_direct_lighting() {
     let Some(dir) = common::scenes_dir() else { return };
     let (cases, skipped) = hw6_direct_lighting(&dir);
-    check(run("CENG 795 2022 and 2019 hw6 direct lighting", cases, skipped, Some(FEW_SAMPLES)).1);
+    check(run("CENG 795 2022 and 2019 hw6 direct lighting", cases, skipped, None).1);
 }
 
 #[test]

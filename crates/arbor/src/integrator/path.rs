@@ -5,11 +5,13 @@
 //! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
 //!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
 //!   lobes, picked in proportion to its weight, as delta directions.
-//! - Light: an emitter (or the environment) met by a ray counts, unless next event estimation sampled it
-//!   already (the course: "discard its contribution"); with `NextEventEstimation` one light is sampled
-//!   at every vertex of a non-delta surface, chosen in proportion to its power, with a shadow ray; with
-//!   `MIS` both count, weighted by the power heuristic (Veach 1997). After a delta lobe, met light
-//!   always counts in full (no light sample could have found it).
+//! - Light: lights no ray can meet (point, spot, directional, the square area light) light every
+//!   non-delta vertex directly, as in the course's renderer (its plain path-traced references are lit by
+//!   their point light). An emitter (or the environment) met by a ray counts, unless next event
+//!   estimation sampled it already (the course: "discard its contribution"); with `NextEventEstimation`
+//!   one of them is sampled at every non-delta vertex, chosen in proportion to its power, with a shadow
+//!   ray; with `MIS` both count, weighted by the power heuristic (Veach 1997). After a delta lobe, met
+//!   light always counts in full (no light sample could have found it).
 //! - Length: at most `MaxRecursionDepth` bounces; with `RussianRoulette` the course's direct form
 //!   instead: after each bounce the path survives with probability `q = min(1, max(beta))` and is divided
 //!   by it, to a safety cap of [`MAX_BOUNCES`].
@@ -38,19 +40,23 @@ pub struct PathTracer<'a> {
     options: PathOptions,
     cull_backfaces: bool,
     camera: Option<&'a Camera>,
-    /// Probability of choosing each light for a light sample: its share of the total power.
+    /// Probability of choosing each light a ray can meet for a light sample: its share of their total
+    /// power; 0 for the others, which are all sampled at every vertex.
     pick: Vec<f32>,
 }
 
 impl<'a> PathTracer<'a> {
     /// A path tracer over `scene`; `cull_backfaces` applies to camera rays only.
     pub fn new(scene: &'a Scene, options: PathOptions, cull_backfaces: bool) -> Self {
-        let powers: Vec<f32> = scene.lights.iter().map(|l| l.power().max(0.0)).collect();
+        let met = |i: usize| scene.lights[i].object().is_some() || scene.environment_light == Some(i);
+        let powers: Vec<f32> =
+            (0..scene.lights.len()).map(|i| if met(i) { scene.lights[i].power().max(0.0) } else { 0.0 }).collect();
         let total: f32 = powers.iter().sum();
         let pick = if total > 0.0 && total.is_finite() {
             powers.iter().map(|p| p / total).collect()
         } else {
-            vec![1.0 / scene.lights.len().max(1) as f32; scene.lights.len()]
+            let n = (0..scene.lights.len()).filter(|&i| met(i)).count().max(1) as f32;
+            (0..scene.lights.len()).map(|i| if met(i) { 1.0 / n } else { 0.0 }).collect()
         };
         PathTracer { scene, options, cull_backfaces, camera: None, pick }
     }
@@ -144,24 +150,32 @@ impl<'a> PathTracer<'a> {
             let local = front || !m.transmits();
 
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
-            let (pick, u) = (rng.next_f32(), rng.next_2d());
-            if o.next_event && local && m.layer.is_none() && (kd != Color::ZERO || ks != Color::ZERO) {
-                if let Some((i, chosen)) = self.choose_light(pick) {
+            if local && m.layer.is_none() && (kd != Color::ZERO || ks != Color::ZERO) {
+                let origin = spawn_origin(scene.offset, &s, ng);
+                let mut direct = |i: usize, u: Vec2, chosen: f32, count: &mut u64| {
                     let light = &scene.lights[i];
-                    if let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) {
-                        *count += 1;
-                        let origin = spawn_origin(scene.offset, &s, ng);
-                        let on_surface = light.object().is_some();
-                        let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, on_surface);
-                        if !scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
-                            let w = if o.mis && ls.pdf > 0.0 {
-                                power_heuristic(chosen * ls.pdf, self.bounce_pdf(ns, ls.wi))
-                            } else {
-                                1.0
-                            };
-                            let f = brdf.f(kd, ks, ls.wi, wo, ns) * ns.dot(ls.wi);
-                            l += beta * f * ls.irradiance * (w / chosen);
-                        }
+                    let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
+                    *count += 1;
+                    let on_surface = light.object().is_some();
+                    let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, on_surface);
+                    if scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
+                        return;
+                    }
+                    let w = if o.mis && ls.pdf > 0.0 {
+                        power_heuristic(chosen * ls.pdf, self.bounce_pdf(ns, ls.wi))
+                    } else {
+                        1.0
+                    };
+                    let f = brdf.f(kd, ks, ls.wi, wo, ns) * ns.dot(ls.wi);
+                    l += beta * f * ls.irradiance * (w / chosen);
+                };
+                for i in (0..scene.lights.len()).filter(|&i| self.pick[i] == 0.0) {
+                    direct(i, rng.next_2d(), 1.0, count);
+                }
+                let (pick, u) = (rng.next_f32(), rng.next_2d());
+                if o.next_event {
+                    if let Some((i, chosen)) = self.choose_light(pick) {
+                        direct(i, u, chosen, count);
                     }
                 }
             }
