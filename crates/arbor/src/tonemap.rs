@@ -45,6 +45,15 @@ pub struct Tonemap {
     pub unit: f32,
 }
 
+/// A film's exposure under a [`Tonemap`] ([`Tonemap::exposure`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exposure {
+    /// Scaled luminance per unit of the film's luminance.
+    pub scale: f64,
+    /// The scaled luminance that burns out to white; `None` without burn-out.
+    pub white: Option<f64>,
+}
+
 /// Luminance of a linear sRGB colour.
 pub fn luminance(c: Color) -> f32 {
     c.dot(LUMINANCE)
@@ -69,10 +78,21 @@ impl Tonemap {
 
     /// The display film: every channel in `[0, 1]`, gamma applied, ready for 8-bit quantisation.
     pub fn apply(&self, film: &Film) -> Film {
+        self.apply_exposure(film, self.exposure(film))
+    }
+
+    /// What the operator takes from a film as a whole: the scale from luminance to scaled luminance
+    /// (key over log-average) and the burn-out white.
+    pub fn exposure(&self, film: &Film) -> Exposure {
         let lum: Vec<f32> = film.pixels.iter().map(|&c| sanitize(luminance(c))).collect();
         let scale = self.key as f64 / log_average(&lum, DELTA * self.unit as f64);
-        let white = self.white(&lum, scale);
-        let pixels = film.pixels.iter().zip(&lum).map(|(&c, &y)| self.map_pixel(c, y, scale, white)).collect();
+        Exposure { scale, white: self.white(&lum, scale) }
+    }
+
+    /// `film` under the exposure of another film (the same tone curve for several images of one scene,
+    /// whose noise would move their own log-averages and burn-out percentiles).
+    pub fn apply_exposure(&self, film: &Film, e: Exposure) -> Film {
+        let pixels = film.pixels.iter().map(|&c| self.map_pixel(c, sanitize(luminance(c)), e.scale, e.white)).collect();
         Film { width: film.width, height: film.height, pixels }
     }
 

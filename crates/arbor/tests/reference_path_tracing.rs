@@ -3,7 +3,10 @@
 //! ([`arbor::image_io::noisy`]): each camera is rendered at four times N samples (seed 1) and at N
 //! samples with seeds 1 and 2; on 16x16 block means of the tone-mapped images the first must be as
 //! close to the reference as the two seeds are to each other, plus 1 level, with every channel's mean
-//! signed difference within 2 levels.
+//! signed difference within 2 levels. The three renders are tone-mapped with the exposure of the
+//! reference EXR (its log-average and burn-out white, from which the official PNG was made): the
+//! photographic operator takes both from the image itself, so a render's own noise (its fireflies, its
+//! black pixels) would shift its exposure and bias the comparison by several levels.
 //!
 //! The default test takes N = [`FEW_SAMPLES`] and the central [`CROP`]-pixel window of every camera (the
 //! noise rule is the same at any N: fewer samples make both sides noisier); the ignored
@@ -18,7 +21,7 @@ use std::time::Instant;
 use arbor::accel::AccelConfig;
 use arbor::film::Film;
 use arbor::image_io::noisy::compare_noisy_rgb8;
-use arbor::image_io::read_rgb8;
+use arbor::image_io::{read_image, read_rgb8};
 use arbor::render::{render, RenderOptions};
 use arbor::renderer::Renderer;
 use arbor::scene::{load_desc, Scene};
@@ -79,10 +82,20 @@ fn window(rgb: &[u8], width: u32, crop: (u32, u32, u32, u32)) -> Vec<u8> {
         .collect()
 }
 
-fn shown(scene: &Scene, camera: usize, film: &Film) -> Vec<u8> {
-    match scene.cameras[camera].tonemap {
-        Some(t) => t.apply(film).to_rgb8(),
-        None => film.to_rgb8(),
+/// The 8-bit image of `film`: under the reference's exposure when the camera tone-maps and the reference
+/// EXR is there (so that the noise of a render does not move its own exposure), else as the camera
+/// writes it.
+fn shown(scene: &Scene, camera: usize, film: &Film, reference_exr: Option<&Film>) -> Vec<u8> {
+    match (scene.cameras[camera].tonemap, reference_exr) {
+        (Some(t), Some(exr)) => {
+            // The official EXR holds the scene's radiance; the film holds it times the radiance scale.
+            let unscaled = film.pixels.iter().map(|&c| c / scene.radiance_scale).collect();
+            let scene_units = Film { width: film.width, height: film.height, pixels: unscaled };
+            let t = t.in_units(1.0);
+            t.apply_exposure(&scene_units, t.exposure(exr)).to_rgb8()
+        }
+        (Some(t), None) => t.apply(film).to_rgb8(),
+        (None, _) => film.to_rgb8(),
     }
 }
 
@@ -108,9 +121,12 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, full: bool) -> Vec<S
             ((w - cw) / 2, (h - ch) / 2, (w - cw) / 2 + cw, (h - ch) / 2 + ch)
         };
         let start = Instant::now();
+        let exr = case.reference.with_extension("exr");
+        let exr = exr.is_file().then(|| read_image(&exr).unwrap_or_else(|e| panic!("{e}")));
         let film = |spp: u32, seed: u64| {
             let opts = RenderOptions { spp: Some(spp), seed, crop: Some(crop), ..Default::default() };
-            shown(scene, case.camera, &render(scene, case.camera, &opts, &|_, _| {}).unwrap().0)
+            let full = render(scene, case.camera, &opts, &|_, _| {}).unwrap().0;
+            shown(scene, case.camera, &full, exr.as_ref())
         };
         let (converged, a, b) = (film(4 * n, 1), film(n, 1), film(n, 2));
         let secs = start.elapsed().as_secs_f64();

