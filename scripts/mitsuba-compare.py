@@ -1,0 +1,432 @@
+#!/usr/bin/env python3
+"""Path tracing speed and noise: Arbor against Mitsuba 3 on the METU CENG 795 Cornell boxes.
+
+Each METU scene (XML) is translated into a Mitsuba scene dict -- same camera, triangles and spheres,
+Lambertian albedo, glass and mirrors, mesh/sphere lights and point lights, path length -- and rendered
+with Mitsuba's `path` integrator in its `scalar_rgb` and `llvm_ad_rgb` variants (the LLVM one once
+untimed first, to compile), and with `arbor render --integrator path`, at the same samples per pixel
+on each thread count. For every render it prints samples per second (width x height x spp / seconds
+of rendering, scene loading excluded; Arbor's from the `render X ms` of its summary line), the RMSE in
+linear radiance against a high-spp render of each renderer (cached in --cache, rendered with another
+seed) and the 1-minute load average (the machine may be shared), then a Markdown table for
+docs/performance.md. When the scene's `../outputs/` folder holds the official image its camera names,
+Mitsuba's high-spp render is compared with it too (each divided by its mean; per pixel, and in 16x16
+blocks, which averages away most of the official image's own noise).
+
+Setup: `pip install mitsuba`; the LLVM variant needs a recent libLLVM (Debian: `apt-get install
+libllvm19`; LIBLLVM below is used when DRJIT_LIBLLVM_PATH is unset and the file exists). Run:
+
+    scripts/mitsuba-compare.py --arbor target/release/arbor --spp 64 --threads 1,2 \\
+        /work/shared/scenes/ceng795-2022/hw6/pathTracing/inputs/cornellbox_jaroslav_path_glass.xml:5
+
+What is translated: materials with SpecularReflectance 0 (any BRDF, or none) become Mitsuba `diffuse`
+with reflectance DiffuseReflectance; `dielectric` becomes `dielectric` (RefractionIndex; an
+AbsorptionCoefficient is dropped with a note); `mirror` becomes a `conductor` with
+specular_reflectance MirrorReflectance. A `LightMesh`/`LightSphere` Radiance is a Mitsuba `area`
+emitter (one-sided, on the side the triangle winding faces), a `PointLight` a `point` emitter.
+MaxRecursionDepth D is Mitsuba max_depth D + 2 unless --max-depth is given (it changes Mitsuba only):
+Mitsuba counts the camera ray as segment 1, the course's renderers recurse D times after the primary
+hit and connect each hit to a light, and D + 2 is what matches the official hw6 path-traced images.
+Russian roulette is off (rr_depth = max_depth). Anything else (a specular lobe, textures, PLY meshes,
+non-uniformly scaled spheres, a lens) is refused with its reason and the scene skipped.
+"""
+
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LIBLLVM):
+    os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
+
+import drjit as dr  # noqa: E402  (after DRJIT_LIBLLVM_PATH)
+import mitsuba as mi  # noqa: E402
+
+# The variant used for references, official-image checks and reading EXR files.
+REF_VARIANT = "llvm_ad_rgb"
+
+
+class Unsupported(Exception):
+    """A scene feature with no faithful Mitsuba translation."""
+
+
+# ---------------------------------------------------------------------------------------------
+# METU XML -> a plain description (numpy), independent of the Mitsuba variant
+
+
+def floats(text):
+    return [float(x) for x in (text or "").split()]
+
+
+def child_floats(node, name, default=None):
+    c = node.find(name)
+    if c is None:
+        if default is None:
+            raise Unsupported(f"<{node.tag} id={node.get('id')}> has no <{name}>")
+        return default
+    return floats(c.text)
+
+
+def read_transforms(root):
+    """Named 4x4 matrices: t1 (Translation), s1 (Scaling), r1 (Rotation, degrees), c1 (Composite)."""
+    out = {}
+    block = root.find("Transformations")
+    for n in [] if block is None else list(block):
+        v = floats(n.text)
+        m = np.eye(4)
+        if n.tag == "Translation":
+            m[:3, 3] = v
+        elif n.tag == "Scaling":
+            m[:3, :3] = np.diag(v)
+        elif n.tag == "Rotation":
+            angle, axis = math.radians(v[0]), np.array(v[1:4]) / np.linalg.norm(v[1:4])
+            k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+            m[:3, :3] = np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+        elif n.tag == "Composite":
+            m = np.array(v).reshape(4, 4)  # rows, as written
+        else:
+            continue
+        out[n.tag[0].lower() + n.get("id").strip()] = m
+    return out
+
+
+def object_transform(node, transforms):
+    """The object's `Transformations` list composed left to right (the first listed applies first)."""
+    m = np.eye(4)
+    t = node.find("Transformations")
+    for name in [] if t is None else t.text.split():
+        m = transforms[name] @ m
+    return m
+
+
+def read_material(mat, notes):
+    """A METU material element as a Mitsuba BSDF dict; what is dropped is appended to notes."""
+    mid = mat.get("id")
+    kind = (mat.get("type") or "").strip()
+    if kind == "dielectric":
+        if any(child_floats(mat, "AbsorptionCoefficient", [0.0])):
+            notes.append(f"material {mid}: AbsorptionCoefficient dropped (Mitsuba `dielectric` has none)")
+        return {"type": "dielectric", "int_ior": child_floats(mat, "RefractionIndex")[0], "ext_ior": 1.0}
+    if kind == "mirror":
+        return {"type": "conductor", "material": "none",
+                "specular_reflectance": {"type": "rgb", "value": child_floats(mat, "MirrorReflectance")}}
+    if kind:
+        raise Unsupported(f"material {mid}: type '{kind}' is not translated")
+    if any(child_floats(mat, "SpecularReflectance", [0.0])):
+        raise Unsupported(f"material {mid}: a specular lobe (SpecularReflectance > 0); Mitsuba 3 has no Phong "
+                          "BRDF, only diffuse surfaces (SpecularReflectance 0) are translated")
+    for legacy in ("Transparency", "MirrorReflectance"):
+        if any(child_floats(mat, legacy, [0.0])):
+            raise Unsupported(f"material {mid}: untyped with {legacy} (legacy glass/mirror) is not translated")
+    return {"type": "diffuse", "reflectance": {"type": "rgb", "value": child_floats(mat, "DiffuseReflectance")}}
+
+
+def write_ply(path, vertices, faces):
+    """A binary PLY of triangles (no normals: Mitsuba shades it flat, as the METU meshes are)."""
+    header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(vertices)}\n"
+              "property float x\nproperty float y\nproperty float z\n"
+              f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n")
+    rows = np.zeros(len(faces), dtype=[("n", "u1"), ("i", "<i4", 3)])
+    rows["n"], rows["i"] = 3, faces
+    with open(path, "wb") as f:
+        f.write(header.encode())
+        f.write(np.asarray(vertices, dtype="<f4").tobytes())
+        f.write(rows.tobytes())
+
+
+def read_camera(root, camera_id):
+    cams = root.findall("Cameras/Camera")
+    if not cams:
+        raise Unsupported("no <Camera>")
+    cam = cams[0] if camera_id is None else next((c for c in cams if c.get("id").strip() == camera_id), None)
+    if cam is None:
+        raise Unsupported(f"no camera with id {camera_id}")
+    for absent in ("FocusDistance", "ApertureSize", "Transformations"):
+        if cam.find(absent) is not None:
+            raise Unsupported(f"camera {cam.get('id')}: <{absent}> is not translated")
+    pos = np.array(child_floats(cam, "Position"))
+    gaze = (np.array(child_floats(cam, "GazePoint")) - pos if cam.find("GazePoint") is not None
+            else np.array(child_floats(cam, "Gaze")))
+    width, height = (int(x) for x in child_floats(cam, "ImageResolution"))
+    if (cam.get("type") or "").strip() == "lookAt":
+        fov_y = child_floats(cam, "FovY")[0]
+    else:
+        left, right, bottom, top = child_floats(cam, "NearPlane")[:4]
+        if not (math.isclose(left, -right) and math.isclose(bottom, -top)):
+            raise Unsupported("an off-centre <NearPlane> window is not translated")
+        fov_y = math.degrees(2 * math.atan(top / child_floats(cam, "NearDistance")[0]))
+    return {"id": cam.get("id").strip(), "position": pos, "gaze": gaze, "up": np.array(child_floats(cam, "Up")),
+            "fov_y": fov_y, "width": width, "height": height,
+            "left_handed": (cam.get("handedness") or "right").strip() == "left",
+            "image_name": cam.find("ImageName").text.strip()}
+
+
+def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp):
+    """(Mitsuba scene dict, camera, max_depth, notes) for `path` (call with a variant set); PLY files go to tmp."""
+    notes = []
+    root = ET.parse(path).getroot()
+    if any(child_floats(root, "BackgroundColor", [0.0])):
+        raise Unsupported("a non-black BackgroundColor is not translated")
+    for tex in ("Textures", "Images", "TextureMap"):
+        if root.find(tex) is not None:
+            raise Unsupported(f"<{tex}> is not translated")
+    cam = read_camera(root, camera_id)
+    verts = np.array(floats(root.findtext("VertexData")), dtype=float).reshape(-1, 3)
+    transforms = read_transforms(root)
+    materials = {m.get("id").strip(): m for m in root.findall("Materials/Material")}
+    if max_depth is None:
+        max_depth = int(root.findtext("MaxRecursionDepth", "0")) + 2
+
+    to_world = mi.ScalarTransform4f().look_at(origin=cam["position"].tolist(),
+                                              target=(cam["position"] + cam["gaze"]).tolist(),
+                                              up=cam["up"].tolist())
+    if cam["left_handed"]:
+        to_world = to_world @ mi.ScalarTransform4f().scale([-1, 1, 1])
+    scene = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": max_depth, "hide_emitters": False},
+        "sensor": {"type": "perspective", "fov_axis": "y", "fov": cam["fov_y"], "to_world": to_world,
+                   "sampler": {"type": "independent", "sample_count": spp},
+                   "film": {"type": "hdrfilm", "width": cam["width"], "height": cam["height"],
+                            "pixel_format": "rgb", "rfilter": {"type": "box"}}},
+    }
+
+    objects = root.find("Objects")
+    for k, obj in enumerate([] if objects is None else list(objects)):
+        shape = shape_of(obj, verts, transforms, tmp / f"{k}.ply")
+        shape["bsdf"] = read_material(materials[obj.findtext("Material").strip()], notes)
+        if obj.tag.startswith("Light"):
+            shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": child_floats(obj, "Radiance")}}
+        scene[f"{obj.tag}_{obj.get('id')}"] = shape
+
+    lights = root.find("Lights")
+    for light in [] if lights is None else list(lights):
+        if light.tag == "AmbientLight":
+            if any(floats(light.text)):
+                notes.append("AmbientLight dropped (no counterpart in a path tracer)")
+        elif light.tag == "PointLight" and light.find("Transformations") is None:
+            scene[f"PointLight_{light.get('id')}"] = {
+                "type": "point", "position": child_floats(light, "Position"),
+                "intensity": {"type": "rgb", "value": child_floats(light, "Intensity")}}
+        else:
+            raise Unsupported(f"<{light.tag}> is not translated")
+    return scene, cam, max_depth, notes
+
+
+def shape_of(obj, verts, transforms, ply_path):
+    """A Mitsuba shape dict (without BSDF) for a Mesh/LightMesh/Sphere/LightSphere element."""
+    m = object_transform(obj, transforms)
+    if obj.tag in ("Sphere", "LightSphere"):
+        linear = m[:3, :3]
+        scale = abs(np.linalg.det(linear)) ** (1 / 3)
+        if not np.allclose(linear.T @ linear, scale**2 * np.eye(3), rtol=1e-5, atol=1e-6):
+            raise Unsupported(f"{obj.tag} {obj.get('id')}: a non-uniformly scaled sphere is not translated")
+        centre = m @ np.append(verts[int(obj.findtext("Center")) - 1], 1.0)
+        return {"type": "sphere", "center": centre[:3].tolist(), "radius": float(obj.findtext("Radius")) * scale}
+    if obj.tag not in ("Mesh", "LightMesh"):
+        raise Unsupported(f"<{obj.tag}> is not translated")
+    faces_node = obj.find("Faces")
+    if faces_node.get("plyFile") or obj.get("shadingMode", "flat").strip() != "flat":
+        raise Unsupported(f"{obj.tag} {obj.get('id')}: only inline flat-shaded faces are translated")
+    ids = np.array(floats(faces_node.text), dtype=int).reshape(-1, 3) + int(faces_node.get("vertexOffset", "0"))
+    used, faces = np.unique(ids, return_inverse=True)
+    local = (m @ np.c_[verts[used - 1], np.ones(len(used))].T).T[:, :3]
+    write_ply(ply_path, local, faces.reshape(-1, 3))
+    return {"type": "ply", "filename": str(ply_path), "face_normals": True}
+
+
+# ---------------------------------------------------------------------------------------------
+# Rendering
+
+
+def load_scene(path, camera_id, spp, max_depth):
+    with tempfile.TemporaryDirectory() as tmp:
+        desc, cam, depth, notes = metu_to_mitsuba(path, camera_id, spp, max_depth, Path(tmp))
+        return mi.load_dict(desc), cam, depth, notes
+
+
+def render_mitsuba(variant, path, camera_id, spp, threads, max_depth, seed=0):
+    """(image, seconds of mi.render) in `variant`; the LLVM variant renders once first to compile."""
+    mi.set_variant(variant)
+    dr.set_thread_count(threads)
+    scene, _, _, _ = load_scene(path, camera_id, spp, max_depth)
+    runs = 2 if variant.startswith("llvm") else 1
+    for _ in range(runs):
+        start = time.perf_counter()
+        img = mi.render(scene, spp=spp, seed=seed)
+        dr.eval(img)
+        dr.sync_thread()
+        seconds = time.perf_counter() - start
+    return np.array(img)[..., :3], seconds
+
+
+def arbor_missing(arbor, integrator):
+    """Why Arbor cannot be run as asked, or None."""
+    if not Path(arbor).exists():
+        return f"{arbor} does not exist (cargo build --release -p arbor-cli)"
+    help_text = subprocess.run([arbor, "render", "--help"], capture_output=True, text=True).stdout
+    if integrator and "--integrator" not in help_text:
+        return f"`{arbor} render --help` has no --integrator option (no path tracer yet)"
+    return None
+
+
+def render_arbor(arbor, integrator, path, camera_id, spp, threads, out, seed=0):
+    """(image, seconds from Arbor's `render X ms` summary), or None with the reason printed."""
+    cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
+           "--seed", str(seed), "-o", str(out), "--no-warnings"]
+    if integrator:
+        cmd += ["--integrator", integrator]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    found = re.search(r"render ([0-9.]+) ms", run.stdout + run.stderr)
+    if run.returncode != 0 or not found:
+        print(f"  Arbor failed (exit {run.returncode}): {' '.join(cmd)}\n    " +
+              (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
+        return None
+    return read_exr(out), float(found.group(1)) / 1e3
+
+
+def read_exr(path):
+    mi.set_variant(REF_VARIANT)
+    return np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3]
+
+
+def write_exr(path, img):
+    mi.set_variant(REF_VARIANT)
+    mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)).write(str(path))
+
+
+def rmse(a, b):
+    return float(np.sqrt(np.mean((np.asarray(a, np.float64) - b) ** 2))) if b is not None else None
+
+
+def mean_relative_difference(a, b, block=1):
+    """Mean |a/mean(a) - b/mean(b)| over block x block pixel averages: the images in relative radiance."""
+    h, w = (a.shape[0] // block) * block, (a.shape[1] // block) * block
+    a, b = (x[:h, :w].reshape(h // block, block, w // block, block, 3).mean(axis=(1, 3)) for x in (a, b))
+    return float(np.mean(np.abs(a / a.mean() - b / b.mean())))
+
+
+# ---------------------------------------------------------------------------------------------
+# The comparison
+
+
+def references(args, path, camera_id, tag, arbor_ok):
+    """High-spp images {renderer: image or None}, rendered once and cached in --cache."""
+    refs = {}
+    mitsuba_file = args.cache / f"{tag}_mitsuba_{args.ref_spp}spp.exr"
+    if not mitsuba_file.exists():
+        print(f"  rendering the Mitsuba reference ({args.ref_spp} spp) ...", flush=True)
+        img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1)
+        write_exr(mitsuba_file, img)
+    refs["Mitsuba"] = read_exr(mitsuba_file)
+    arbor_file = args.cache / f"{tag}_arbor_{args.ref_spp}spp.exr"
+    refs["Arbor"] = None
+    if arbor_ok and not arbor_file.exists():
+        print(f"  rendering the Arbor reference ({args.ref_spp} spp) ...", flush=True)
+        render_arbor(args.arbor, args.arbor_integrator, path, camera_id, args.ref_spp, max(args.threads), arbor_file,
+                     seed=1)
+    if arbor_ok and arbor_file.exists():
+        refs["Arbor"] = read_exr(arbor_file)
+    return refs
+
+
+def compare_scene(args, spec, arbor_ok):
+    """Rows of the table for one SCENE[:CAMERA] argument."""
+    path, _, camera_id = spec.partition(":")
+    path = Path(path)
+    print(f"{path.name}{':' + camera_id if camera_id else ''}", flush=True)
+    mi.set_variant(REF_VARIANT)
+    try:
+        _, cam, depth, notes = load_scene(path, camera_id or None, args.spp, args.max_depth)
+    except Unsupported as e:
+        print(f"  skipped: {e}")
+        return []
+    for note in notes:
+        print(f"  note: {note}")
+    camera_id = cam["id"]
+    tag = f"{path.stem}_cam{camera_id}_d{depth}"
+    print(f"  camera {camera_id}, {cam['width']}x{cam['height']}, Mitsuba max_depth {depth}", flush=True)
+    refs = references(args, path, camera_id, tag, arbor_ok)
+    official = path.parent.parent / "outputs" / cam["image_name"]
+    if official.exists():
+        ref, off = refs["Mitsuba"], read_exr(official)
+        print(f"  Mitsuba {args.ref_spp} spp vs official {official.name}: mean ratio {ref.mean() / off.mean():.4f}, "
+              f"mean |relative difference| {mean_relative_difference(ref, off):.4f} per pixel, "
+              f"{mean_relative_difference(ref, off, 16):.4f} in 16x16 blocks")
+
+    samples = cam["width"] * cam["height"] * args.spp
+    rows = []
+    renderers = [(v, lambda t, v=v: render_mitsuba(v, path, camera_id, args.spp, t, args.max_depth))
+                 for v in args.variants]
+    if arbor_ok:
+        out = args.cache / f"{tag}_arbor_run.exr"
+        renderers.append(("Arbor", lambda t: render_arbor(args.arbor, args.arbor_integrator, path, camera_id,
+                                                          args.spp, t, out)))
+    for name, render in renderers:
+        for threads in args.threads:
+            result = render(threads)
+            if result is None:
+                continue
+            img, seconds = result
+            row = {"scene": f"{path.stem}:{camera_id}", "renderer": name, "threads": threads,
+                   "load": os.getloadavg()[0], "seconds": seconds, "samples_per_s": samples / seconds,
+                   "rmse_mitsuba": rmse(img, refs["Mitsuba"]), "rmse_arbor": rmse(img, refs["Arbor"])}
+            print(f"  {name:12} {threads} threads: {seconds:7.2f} s  {row['samples_per_s'] / 1e6:6.2f} M samples/s  "
+                  f"RMSE vs Mitsuba ref {fmt(row['rmse_mitsuba'])}  vs Arbor ref {fmt(row['rmse_arbor'])}  "
+                  f"load {row['load']:.1f}", flush=True)
+            rows.append(row)
+    return rows
+
+
+def fmt(x):
+    return "n/a" if x is None else f"{x:.4f}"
+
+
+def markdown(rows, args):
+    lines = [f"| scene:camera | renderer | threads | render s | M samples/s | RMSE vs Mitsuba {args.ref_spp} spp "
+             f"| RMSE vs Arbor {args.ref_spp} spp | load |",
+             "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['scene']} | {r['renderer']} | {r['threads']} | {r['seconds']:.2f} | "
+                     f"{r['samples_per_s'] / 1e6:.2f} | {fmt(r['rmse_mitsuba'])} | {fmt(r['rmse_arbor'])} | {r['load']:.1f} |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("scenes", nargs="+", metavar="SCENE.xml[:CAMERA_ID]")
+    parser.add_argument("--arbor", default="target/release/arbor", help="the arbor binary")
+    parser.add_argument("--arbor-integrator", default="path",
+                        help="value of arbor's --integrator; empty: leave the flag out (Arbor's default renderer)")
+    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--threads", default="1,2", help="comma-separated thread counts")
+    parser.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb", help="Mitsuba variants to time")
+    parser.add_argument("--ref-spp", type=int, default=1024, help="samples per pixel of the reference renders")
+    parser.add_argument("--cache", type=Path, default=Path("target/mitsuba-compare"), help="folder of references")
+    parser.add_argument("--max-depth", type=int, help="Mitsuba's max_depth instead of MaxRecursionDepth + 2 (Mitsuba only)")
+    args = parser.parse_args()
+    args.threads = [int(t) for t in args.threads.split(",")]
+    args.variants = args.variants.split(",")
+    args.cache.mkdir(parents=True, exist_ok=True)
+
+    missing = arbor_missing(args.arbor, args.arbor_integrator)
+    if missing:
+        print(f"ARBOR LEFT OUT: {missing}; only Mitsuba's side is measured.", flush=True)
+    arbor_ok = missing is None
+    rows = [row for spec in args.scenes for row in compare_scene(args, spec, arbor_ok)]
+    print()
+    print(markdown(rows, args))
+    return 0 if rows else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
