@@ -97,17 +97,7 @@ impl EmissiveMesh {
     /// The solid-angle density of the point `q` of a triangle of unit normal `n` seen from `p`, and the
     /// unit direction and distance to it; `None` when `q` faces away or coincides with `p`.
     fn towards(&self, p: Vec3, q: Vec3, n: Vec3) -> Option<(Vec3, f32, f32)> {
-        let to = q - p;
-        let d2 = to.length_squared();
-        let dist = d2.sqrt();
-        let wi = to / dist;
-        let cos_l = -n.dot(wi);
-        // Negated so that a NaN (a zero distance, a degenerate triangle) gives no sample.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if !(cos_l > 0.0 && d2 > 0.0) {
-            return None;
-        }
-        Some((wi, dist, d2 / (self.area() * cos_l)))
+        super::towards_area_point(p, q, n, 1.0 / self.area())
     }
 }
 

@@ -59,17 +59,7 @@ impl EmissiveSphere {
     /// and the unit direction and distance to it; `None` when `q` faces away from `p`.
     fn by_area(&self, p: Vec3, q: Vec3, n_obj: Vec3) -> Option<(Vec3, f32, f32)> {
         let n = self.sphere.transform.normal(n_obj).normalize_or_zero();
-        let to = q - p;
-        let d2 = to.length_squared();
-        let dist = d2.sqrt();
-        let wi = to / dist;
-        let cos_l = -n.dot(wi);
-        // Negated so that a NaN (a zero distance) gives no sample.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if !(cos_l > 0.0 && d2 > 0.0) {
-            return None;
-        }
-        Some((wi, dist, self.area_pdf(n_obj) * d2 / cos_l))
+        super::towards_area_point(p, q, n, self.area_pdf(n_obj))
     }
 
     /// The round sphere's cone seen from `p`: centre direction, `1 - cos θ_max` and `sin² θ_max`;

@@ -70,3 +70,20 @@ pub trait Light: fmt::Debug + Send + Sync {
         None
     }
 }
+
+/// A point `q` of a light's surface, of unit normal `n`, chosen with density `area_pdf` per unit area,
+/// seen from `p`: the unit direction and distance to it and the density per unit solid angle,
+/// `area_pdf · d² / cos θ_l`; `None` when `q` faces away from `p` or coincides with it.
+fn towards_area_point(p: Vec3, q: Vec3, n: Vec3, area_pdf: f32) -> Option<(Vec3, f32, f32)> {
+    let to = q - p;
+    let d2 = to.length_squared();
+    let dist = d2.sqrt();
+    let wi = to / dist;
+    let cos_l = -n.dot(wi);
+    // Negated so that a NaN (a zero distance, a degenerate triangle) gives no sample.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(cos_l > 0.0 && d2 > 0.0) {
+        return None;
+    }
+    Some((wi, dist, area_pdf * d2 / cos_l))
+}
