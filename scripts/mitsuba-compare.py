@@ -279,6 +279,10 @@ def arbor_missing(arbor, integrator):
     return None
 
 
+# Arbor's EXR holds the radiance times the scene's radiance scale, 1/255 for the course's files.
+ARBOR_UNIT = 255.0
+
+
 def render_arbor(arbor, integrator, path, camera_id, spp, threads, out, seed=0):
     """(image, seconds from Arbor's `render X ms` summary), or None with the reason printed."""
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
@@ -291,7 +295,7 @@ def render_arbor(arbor, integrator, path, camera_id, spp, threads, out, seed=0):
         print(f"  Arbor failed (exit {run.returncode}): {' '.join(cmd)}\n    " +
               (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
         return None
-    return read_exr(out), float(found.group(1)) / 1e3
+    return read_exr(out) * ARBOR_UNIT, float(found.group(1)) / 1e3
 
 
 def read_exr(path):
@@ -335,7 +339,7 @@ def references(args, path, camera_id, tag, arbor_ok):
         render_arbor(args.arbor, args.arbor_integrator, path, camera_id, args.ref_spp, max(args.threads), arbor_file,
                      seed=1)
     if arbor_ok and arbor_file.exists():
-        refs["Arbor"] = read_exr(arbor_file)
+        refs["Arbor"] = read_exr(arbor_file) * ARBOR_UNIT
     return refs
 
 
