@@ -35,7 +35,10 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
             _ => None,
         })
         .collect();
-    let loaded: HashMap<usize, Arc<TexImage>> = wanted
+    // One decode per file: the first id that names it loads it (and answers for it if it cannot).
+    let mut seen: HashSet<&Path> = HashSet::new();
+    let files: Vec<usize> = wanted.iter().copied().filter(|&i| seen.insert(desc.images[i].path.as_path())).collect();
+    let loaded: HashMap<&Path, Arc<TexImage>> = files
         .par_iter()
         .map(|&i| {
             let img = &desc.images[i];
@@ -48,15 +51,12 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
                 Error::input(img.loc.clone(), format!("cannot read texture image '{}': {why}", img.path.display()))
             })?;
             let image = if mipmapped.contains(img.path.as_path()) { image.with_mipmaps() } else { image };
-            Ok((i, Arc::new(image)))
+            Ok((img.path.as_path(), Arc::new(image)))
         })
         .collect::<Result<_>>()?;
-    // Share one decoded image between the maps that name the same file under different ids.
-    let mut by_path: HashMap<&Path, Arc<TexImage>> = HashMap::new();
-    let images: HashMap<usize, Arc<TexImage>> = wanted
-        .iter()
-        .map(|&i| (i, by_path.entry(&desc.images[i].path).or_insert_with(|| loaded[&i].clone()).clone()))
-        .collect();
+    // Maps that name the same file under different ids share its one decoded image.
+    let images: HashMap<usize, Arc<TexImage>> =
+        wanted.iter().map(|&i| (i, loaded[desc.images[i].path.as_path()].clone())).collect();
     Ok(desc.textures.iter().map(|t| build_texture(t, &images)).collect())
 }
 
