@@ -36,8 +36,7 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
     let film = arbor::farm::merge(&parts)?;
     // Written as the single-process render writes it: the camera's tone mapping, the PNG beside HDR.
     let first = &parts[0].1;
-    let tonemap =
-        first.tonemap.or_else(|| crate::outputs::hdr_preview(&args.out).map(|t| t.in_units(first.sums.scale)));
+    let tonemap = first.tonemap.or_else(|| crate::outputs::hdr_preview(&args.out, first.sums.scale));
     signals.enter(crate::signals::Stage::Render);
     let written = signals.writing(|| arbor::image_io::write_outputs(&args.out, &film, tonemap.as_ref()))?;
     signals.check()?;

@@ -97,10 +97,11 @@ pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
     }
 }
 
-/// The tone mapping of the PNG beside a high-dynamic-range image `path` whose camera names none: every
-/// HDR image gets its PNG, by the course's settings ([`Tonemap::PREVIEW`]); `None` for other formats.
-pub fn hdr_preview(path: &Path) -> Option<Tonemap> {
-    arbor::image_io::is_hdr_path(path).then_some(Tonemap::PREVIEW)
+/// The tone mapping of the PNG beside a high-dynamic-range image `path` whose camera names none, for a
+/// film holding `unit` per unit of scene radiance: every HDR image gets its PNG, by the course's
+/// settings ([`Tonemap::PREVIEW`]); `None` for other formats.
+pub fn hdr_preview(path: &Path, unit: f32) -> Option<Tonemap> {
+    arbor::image_io::is_hdr_path(path).then_some(Tonemap::PREVIEW.in_units(unit))
 }
 
 #[cfg(test)]

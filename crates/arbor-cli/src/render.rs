@@ -261,7 +261,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 let tonemap = if args.debug.is_some() {
                     None
                 } else {
-                    tonemap.or_else(|| hdr_preview(&target).map(|t| t.in_units(scene.radiance_scale)))
+                    tonemap.or_else(|| hdr_preview(&target, scene.radiance_scale))
                 };
                 let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap.as_ref()))?;
                 extra = written.into_iter().filter(|p| *p != target).collect();
