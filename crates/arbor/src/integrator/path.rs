@@ -200,11 +200,7 @@ impl<'a> PathTracer<'a> {
                 };
                 beta *= lobe.weight * (total / luminance(lobe.weight));
                 last = None;
-                inside = match (lobe.transmitted, front) {
-                    (false, _) => inside,
-                    (true, true) => m.interior_absorption(),
-                    (true, false) => None,
-                };
+                inside = m.medium_after(lobe, front, inside);
                 lobe.dir
             } else {
                 let (wi, pdf) = if o.importance_sampling {

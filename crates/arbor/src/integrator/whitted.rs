@@ -156,13 +156,7 @@ impl<'a> Whitted<'a> {
                 // grass_desert); with normals turned to the ray, that is the lobe's own side.
                 let side = if m.transmits() || scene.flip_back_faces { dir } else { ng };
                 let origin = spawn_origin(scene.offset, &s, side);
-                // A transmitted ray enters the glass when it came from outside, and leaves it otherwise;
-                // a reflected one stays in whatever medium it was in.
-                let next_inside = match (lobe.transmitted, front) {
-                    (false, _) => inside,
-                    (true, true) => m.interior_absorption(),
-                    (true, false) => None,
-                };
+                let next_inside = m.medium_after(&lobe, front, inside);
                 let next = Carried { depth: depth + 1, inside: next_inside, cone: cone.after(hit.t * d.length()) };
                 let l = self.li(&Ray::new(origin, dir).with_time(ray.time), next, rng, count);
                 color += lobe.weight * l;

@@ -109,6 +109,18 @@ impl Material {
         self.layer.as_ref().is_some_and(|l| l.transmits())
     }
 
+    /// The absorption of the medium a ray travels in after following `lobe` from this surface, when it
+    /// travelled in `current` before and arrived from outside if `entering`: a transmitted ray enters the
+    /// material's interior from outside and leaves it otherwise; a reflected one stays where it was.
+    #[inline]
+    pub fn medium_after(&self, lobe: &Lobe, entering: bool, current: Option<Color>) -> Option<Color> {
+        match (lobe.transmitted, entering) {
+            (false, _) => current,
+            (true, true) => self.interior_absorption(),
+            (true, false) => None,
+        }
+    }
+
     /// The absorption of the medium behind the surface ([`SpecularLayer::interior_absorption`]).
     #[inline]
     pub fn interior_absorption(&self) -> Option<Color> {
