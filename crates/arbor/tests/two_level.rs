@@ -130,6 +130,24 @@ fn two_level_every_structure_matches_brute_force_on_random_transformed_scenes() 
 }
 
 #[test]
+fn two_level_bvh_top_levels_give_every_object_a_leaf_of_its_own() {
+    // An object is a structure of its own: a leaf that grouped objects would send every ray that meets
+    // the leaf's box into each of them. Eight flat walls and boxes, as a Cornell box has, are what the
+    // SAH's triangle costs would put in one leaf.
+    let mut objects = Vec::new();
+    for k in 0..8 {
+        let t = Transform::translate(Vec3::new(k as f32 * 0.1, 0.0, 0.0));
+        objects.push(object("Mesh", ShapeDesc::Mesh { source: MeshSource::Inline(quad()), smooth: false }, t));
+    }
+    let d = desc(objects);
+    for kind in [AccelKind::BvhSah, AccelKind::BvhMedian, AccelKind::BvhBottomUp] {
+        let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
+        let top = g.top.stats();
+        assert_eq!((top.primitives, top.leaves), (8, 8), "{kind}: {top:?}");
+    }
+}
+
+#[test]
 fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
     // The same scene with every mesh taken to world space up front: the closest hit lands on the same
     // primitive, at the same distance up to rounding (rays are transformed instead of triangles).
@@ -182,8 +200,8 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
 
 #[test]
 fn two_level_batches_give_every_ray_its_own_querys_hit() {
-    // One transformed mesh with a plane beside it, a few objects, and a random scene of more objects
-    // than are swept (each ray walks the top level); invalid rays mixed in.
+    // One transformed mesh with a plane beside it (its batch traced through the mesh at once), a few
+    // objects and a random scene of many (each ray walks the top level); invalid rays mixed in.
     let mut rng = Lcg(23);
     let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
     let indices: Vec<[u32; 3]> = (0..200).map(|k| [k * 3 % 300, (k * 3 + 1) % 300, (k * 3 + 2) % 300]).collect();
@@ -193,13 +211,12 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         object("Mesh", ShapeDesc::Mesh { source: MeshSource::Inline(mesh), smooth: false }, t),
         object("Plane", ShapeDesc::Plane { point: Vec3::new(0.0, -1.5, 0.0), normal: Vec3::Y }, Transform::IDENTITY),
     ]);
-    // Few objects (swept object by object): meshes, instances and spheres, plus an instance in the very
-    // place of the first mesh, whose hits tie with it and must go to the first.
+    // Few objects: meshes, instances and spheres, plus an instance in the very place of the first mesh,
+    // whose hits tie with it and must go to the first.
     let mut few = random_scene(&mut rng);
     few.objects.truncate(6);
     let same_place = few.objects[0].transform;
     few.objects.push(object("MeshInstance", ShapeDesc::Instance { base: 0 }, same_place));
-    assert!(few.objects.len() <= arbor::scene::SWEEP_OBJECTS);
     for d in [one_mesh, few, random_scene(&mut rng)] {
         // Aimed at the middle of the scene, where its objects are.
         let mut rays: Vec<Ray> = (0..3_000)

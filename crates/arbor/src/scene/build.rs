@@ -273,8 +273,26 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     counts.degenerate = shapes.iter().map(|s| s.mesh.check().degenerate).sum();
     counts.planes = planes.len();
     counts.objects = objects.len();
-    let top = spec.build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
+    let top = top_level(spec).build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
+}
+
+/// The top level's structure: the scene's kind with one object per leaf (for the BVH kinds). An object
+/// is a whole structure of its own, far dearer to enter than the box test that keeps a ray out of it,
+/// while the SAH's costs are a triangle's: they would put a Cornell box's eight objects in one leaf, and
+/// every ray would enter every object. The octree and kd-tree keep their parameters.
+fn top_level(spec: &AccelConfig) -> AccelConfig {
+    let mut top = spec.clone();
+    match &mut top {
+        AccelConfig::BvhSah(p) => {
+            p.max_leaf_prims = 1;
+            p.leaf_block = 1;
+        }
+        AccelConfig::BvhMedian(p) => p.max_leaf_prims = 1,
+        AccelConfig::BvhBottomUp(p) => p.max_leaf_prims = 1,
+        _ => {}
+    }
+    top
 }
 
 /// An object's motion over the shutter interval, `None` when it stands still.

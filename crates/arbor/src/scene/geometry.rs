@@ -22,11 +22,6 @@ use crate::accel::{Accel, AccelStats, Hit, PrimHit, Primitives, TraversalCounts}
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 
-/// Scenes of at most this many bounded objects trace batches object by object
-/// ([`SceneGeometry::intersect_many`]): up to one wide node's fan-out, what a ray pays for meeting every
-/// object's root is about what a walk of the top level costs it.
-pub const SWEEP_OBJECTS: usize = 8;
-
 /// A mesh in object space under its own structure; shared by every object that shows it.
 pub struct MeshShape {
     /// Triangles in object space; `normals` are set for smooth shading only.
@@ -220,53 +215,29 @@ impl SceneGeometry {
     /// [`SceneGeometry::intersect`] for a batch (the camera rays of a few pixels): `out[i]` becomes
     /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
     ///
-    /// A scene of at most [`SWEEP_OBJECTS`] bounded objects is swept object by object, each mesh
-    /// tracing the whole batch at once ([`Accel::intersect_many`], which the BVH traces two rays at a
-    /// time) up to the closest hit found so far, which a later object must beat strictly: the smallest
-    /// `t` wins and ties go to the lowest object, as at the top level. Past that many objects, each ray
-    /// walks the top level on its own, which skips the objects it does not come near.
+    /// A scene of one bounded mesh traces the whole batch through the mesh's structure at once
+    /// ([`Accel::intersect_many`], which the BVH traces two rays at a time). With more objects each ray
+    /// walks the top level on its own, whose boxes keep it out of the objects it does not come near:
+    /// sweeping every object with the batch costs more as soon as a ray would skip one.
     ///
     /// # Panics
     /// When `rays` and `out` differ in length.
     pub fn intersect_many(&self, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
-        let objects = &self.objects.objects;
-        if objects.len() > SWEEP_OBJECTS {
+        let [object @ SceneObject { shape: Shape::Mesh(m), .. }] = self.objects.objects.as_slice() else {
             for (o, r) in out.iter_mut().zip(rays) {
                 *o = self.intersect(r, t_max);
             }
             return;
-        }
-        out.fill(None);
-        let mut limit = vec![t_max; rays.len()];
-        let (mut local, mut found) = (Vec::new(), Vec::new());
-        for (i, object) in objects.iter().enumerate() {
-            match &object.shape {
-                Shape::Mesh(m) => {
-                    local.clear();
-                    local.extend(rays.iter().map(|r| object.local_ray(r)));
-                    found.resize(rays.len(), None);
-                    m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
-                    for ((o, l), h) in out.iter_mut().zip(&mut limit).zip(&found) {
-                        if let Some(h) = h {
-                            *o = Some(Hit::new(i as u32, nested(*h)));
-                            *l = h.t;
-                        }
-                    }
-                }
-                Shape::Sphere(_) => {
-                    for ((o, l), r) in out.iter_mut().zip(&mut limit).zip(rays) {
-                        if let Some(h) = self.objects.intersect(i, r, *l) {
-                            *o = Some(Hit::new(i as u32, h));
-                            *l = h.t;
-                        }
-                    }
-                }
-            }
-        }
+        };
+        let local: Vec<Ray> = rays.iter().map(|r| object.local_ray(r)).collect();
+        let limit = vec![t_max; rays.len()];
+        let mut found = vec![None; rays.len()];
+        m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
         // An invalid ray hits nothing, planes included, as in `intersect`.
-        for (o, r) in out.iter_mut().zip(rays) {
-            *o = if r.is_valid() { self.intersect_planes(r, t_max, *o, None) } else { None };
+        for ((o, r), h) in out.iter_mut().zip(rays).zip(found) {
+            let best = h.map(|h| Hit::new(0, nested(h)));
+            *o = if r.is_valid() { self.intersect_planes(r, t_max, best, None) } else { None };
         }
     }
 

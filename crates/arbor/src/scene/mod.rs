@@ -14,9 +14,7 @@ mod runtime;
 
 pub use build::{build_camera, build_geometry};
 pub use desc::*;
-pub use geometry::{
-    MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape, SWEEP_OBJECTS,
-};
+pub use geometry::{MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape};
 pub use limits::{check_limits, SceneLimits};
 pub use readers::{load_desc, parse_desc};
 pub use runtime::{RayOffset, Scene, Surface};
