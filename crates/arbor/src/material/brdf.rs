@@ -67,7 +67,17 @@ impl Brdf {
             return Color::ZERO;
         }
         let p = self.exponent;
+        // A material without a specular colour skips its lobe's power (most of a diffuse surface's
+        // cost); the diffuse term is the same either way.
+        let ks_zero = ks == Color::ZERO;
         match self.model {
+            BrdfModel::OriginalPhong | BrdfModel::ModifiedPhong { normalized: false } if ks_zero => kd,
+            BrdfModel::OriginalBlinnPhong | BrdfModel::ModifiedBlinnPhong { normalized: false } if ks_zero => kd,
+            BrdfModel::ModifiedPhong { normalized: true } | BrdfModel::ModifiedBlinnPhong { normalized: true }
+                if ks_zero =>
+            {
+                kd / PI
+            }
             BrdfModel::OriginalPhong => kd + ks * (phong_lobe(wi, wo, n, p) / cos_i),
             BrdfModel::ModifiedPhong { normalized: false } => kd + ks * phong_lobe(wi, wo, n, p),
             BrdfModel::ModifiedPhong { normalized: true } => {
