@@ -4,7 +4,9 @@
 Each METU scene (XML) is translated into a Mitsuba scene dict -- same camera, triangles and spheres,
 Lambertian albedo, glass and mirrors, mesh/sphere lights and point lights, path length -- and rendered
 with Mitsuba's `path` integrator in its `scalar_rgb` and `llvm_ad_rgb` variants (the LLVM one once
-untimed first, to compile), and with `arbor render --integrator path`, at the same samples per pixel
+untimed first, to compile), and with `arbor render --integrator path --path-options mis` (the same
+estimator as Mitsuba's: cosine-sampled bounces and light samples weighted by MIS; --arbor-path-options
+picks another, '' the scene's RendererParams), at the same samples per pixel
 on each thread count. For every render it prints samples per second (width x height x spp / seconds
 of rendering, scene loading excluded; Arbor's from the `render X ms` of its summary line), the RMSE in
 linear radiance against a high-spp render of each renderer (cached in --cache, rendered with another
@@ -269,13 +271,15 @@ def render_mitsuba(variant, path, camera_id, spp, threads, max_depth, seed=0):
     return np.array(img)[..., :3], seconds
 
 
-def arbor_missing(arbor, integrator):
+def arbor_missing(arbor, integrator, path_options):
     """Why Arbor cannot be run as asked, or None."""
     if not Path(arbor).exists():
         return f"{arbor} does not exist (cargo build --release -p arbor-cli)"
     help_text = subprocess.run([arbor, "render", "--help"], capture_output=True, text=True).stdout
     if integrator and "--integrator" not in help_text:
         return f"`{arbor} render --help` has no --integrator option (no path tracer yet)"
+    if path_options and "--path-options" not in help_text:
+        return f"`{arbor} render --help` has no --path-options option (pass --arbor-path-options '')"
     return None
 
 
@@ -283,12 +287,14 @@ def arbor_missing(arbor, integrator):
 ARBOR_UNIT = 255.0
 
 
-def render_arbor(arbor, integrator, path, camera_id, spp, threads, out, seed=0):
+def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0):
     """(image, seconds from Arbor's `render X ms` summary), or None with the reason printed."""
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
            "--seed", str(seed), "-o", str(out), "--no-warnings"]
     if integrator:
         cmd += ["--integrator", integrator]
+    if integrator and path_options:
+        cmd += ["--path-options", path_options]
     run = subprocess.run(cmd, capture_output=True, text=True)
     found = re.search(r"render ([0-9.]+) ms", run.stdout + run.stderr)
     if run.returncode != 0 or not found:
@@ -332,12 +338,12 @@ def references(args, path, camera_id, tag, arbor_ok):
         img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1)
         write_exr(mitsuba_file, img)
     refs["Mitsuba"] = read_exr(mitsuba_file)
-    arbor_file = args.cache / f"{tag}_arbor_{args.ref_spp}spp.exr"
+    arbor_file = args.cache / f"{tag}_arbor_{args.arbor_path_options or 'scene'}_{args.ref_spp}spp.exr"
     refs["Arbor"] = None
     if arbor_ok and not arbor_file.exists():
         print(f"  rendering the Arbor reference ({args.ref_spp} spp) ...", flush=True)
-        render_arbor(args.arbor, args.arbor_integrator, path, camera_id, args.ref_spp, max(args.threads), arbor_file,
-                     seed=1)
+        render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options, path, camera_id, args.ref_spp,
+                     max(args.threads), arbor_file, seed=1)
     if arbor_ok and arbor_file.exists():
         refs["Arbor"] = read_exr(arbor_file) * ARBOR_UNIT
     return refs
@@ -373,8 +379,8 @@ def compare_scene(args, spec, arbor_ok):
                  for v in args.variants]
     if arbor_ok:
         out = args.cache / f"{tag}_arbor_run.exr"
-        renderers.append(("Arbor", lambda t: render_arbor(args.arbor, args.arbor_integrator, path, camera_id,
-                                                          args.spp, t, out)))
+        renderers.append(("Arbor", lambda t: render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options,
+                                                          path, camera_id, args.spp, t, out)))
     for name, render in renderers:
         for threads in args.threads:
             result = render(threads)
@@ -411,6 +417,10 @@ def main():
     parser.add_argument("--arbor", default="target/release/arbor", help="the arbor binary")
     parser.add_argument("--arbor-integrator", default="path",
                         help="value of arbor's --integrator; empty: leave the flag out (Arbor's default renderer)")
+    parser.add_argument("--arbor-path-options", default="mis",
+                        help="value of arbor's --path-options (default mis: light and BSDF samples weighted by the "
+                             "power heuristic, the estimator of Mitsuba's path integrator); empty: the scene's "
+                             "RendererParams")
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--threads", default="1,2", help="comma-separated thread counts")
     parser.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb", help="Mitsuba variants to time")
@@ -422,7 +432,7 @@ def main():
     args.variants = args.variants.split(",")
     args.cache.mkdir(parents=True, exist_ok=True)
 
-    missing = arbor_missing(args.arbor, args.arbor_integrator)
+    missing = arbor_missing(args.arbor, args.arbor_integrator, args.arbor_path_options)
     if missing:
         print(f"ARBOR LEFT OUT: {missing}; only Mitsuba's side is measured.", flush=True)
     arbor_ok = missing is None

@@ -14,6 +14,7 @@ macro_rules! say {
 mod bench;
 mod diff;
 mod info;
+mod integrator;
 mod memory;
 mod merge;
 mod outputs;

@@ -17,7 +17,7 @@ use arbor::farm::{write_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, render_sums, RenderOptions, RenderStats};
-use arbor::renderer::{PathOptions, Renderer};
+use arbor::renderer::Renderer;
 use arbor::scene::{check_limits, load_desc, parse_desc, Scene, SceneDesc, SceneLimits};
 use clap::Args;
 use serde_json::json;
@@ -55,10 +55,8 @@ pub struct RenderArgs {
     /// gives the same image on any number of threads, tiles or slices; another seed, independent noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// The integrator, overriding the scene's Renderer: whitted, or path (a camera that names no path
-    /// tracer options gets importance sampling, next event estimation and MIS).
-    #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorArg>,
+    #[command(flatten)]
+    pub integrator: crate::integrator::IntegratorArgs,
     #[command(flatten)]
     pub threads: crate::threads::ThreadsArg,
     /// Environment map for rays that miss: a lat-long image, or a folder holding six cube faces
@@ -161,6 +159,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     let slice = Slice::from_args(&args.slice, args.crop, &args.out, args.debug.is_some())?;
     // Checked before any file is read.
     let spec = accel_spec(args.accel, &args.accel_params)?;
+    args.integrator.renderer(Renderer::Whitted).map_err(Failure::Usage)?;
     let t0 = Instant::now();
     let desc = read_scene(&args.scene)?;
     let parse_time = t0.elapsed();
@@ -224,7 +223,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
-        let base = RenderOptions { renderer: args.integrator.map(|i| i.renderer(cam.renderer)), ..base.clone() };
+        let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?;
+        let base = RenderOptions { renderer, ..base.clone() };
         // The tone-mapped PNG beside a high-dynamic-range image.
         let mut extra = Vec::new();
         // A debug view is written as it is.
@@ -377,23 +377,4 @@ fn summary(
         s.mean_depth,
         args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
     );
-}
-/// `--integrator`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum IntegratorArg {
-    /// Whitted-style ray tracing.
-    Whitted,
-    /// Path tracing.
-    Path,
-}
-
-impl IntegratorArg {
-    /// The renderer for a camera whose scene names `scene`: a path tracer keeps the scene's options.
-    pub fn renderer(self, scene: Renderer) -> Renderer {
-        match (self, scene) {
-            (IntegratorArg::Whitted, _) => Renderer::Whitted,
-            (IntegratorArg::Path, Renderer::PathTracing(o)) => Renderer::PathTracing(o),
-            (IntegratorArg::Path, Renderer::Whitted) => Renderer::PathTracing(PathOptions::DEFAULT),
-        }
-    }
 }

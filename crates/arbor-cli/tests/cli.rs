@@ -129,6 +129,11 @@ fn cli_usage_error_exits_2() {
     assert_eq!(arbor(&["render", "--spp", "zero"], tmp.path()).status.code(), Some(2));
     assert_eq!(arbor(&["frobnicate"], tmp.path()).status.code(), Some(2));
     assert_eq!(arbor(&["render", "--accel", "quadtree"], tmp.path()).status.code(), Some(2));
+    assert_eq!(arbor(&["render", "--path-options", "mis,fast"], tmp.path()).status.code(), Some(2));
+    let o = arbor(&["render", "--integrator", "whitted", "--path-options", "mis"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--path-options sets the path tracer's options"), "{}", stderr(&o));
+    assert!(!tmp.path().join("cornell_box.png").exists(), "a usage error renders nothing");
 }
 
 #[test]

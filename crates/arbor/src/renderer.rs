@@ -33,4 +33,14 @@ impl PathOptions {
     /// event estimation and multiple importance sampling, Russian roulette after the recursion limit.
     pub const DEFAULT: PathOptions =
         PathOptions { importance_sampling: true, next_event: true, russian_roulette: false, mis: true };
+
+    /// These options with what they imply: MIS weighs light samples against importance-sampled bounces,
+    /// so it turns both on.
+    pub fn implied(self) -> PathOptions {
+        if self.mis {
+            PathOptions { importance_sampling: true, next_event: true, ..self }
+        } else {
+            self
+        }
+    }
 }

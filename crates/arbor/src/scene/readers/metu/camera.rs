@@ -158,9 +158,7 @@ impl Reader<'_> {
                     };
                     *flag = true;
                 }
-                if o.mis {
-                    (o.next_event, o.importance_sampling) = (true, true);
-                }
+                let o = o.implied();
                 if self.desc.max_depth == 0 && !o.russian_roulette {
                     let msg = format!(
                         "Camera {id}: path tracing with MaxRecursionDepth 0 follows no bounce: emitters and, with \
