@@ -28,6 +28,9 @@ pub trait EmitterMesh: Send + Sync {
     fn intersect(&self, ray: &Ray) -> Option<Hit>;
 }
 
+/// Lights of at most this many triangles find a sample's triangle by counting, not by binary search.
+const LINEAR_SEARCH: usize = 32;
+
 /// A mesh light.
 pub struct EmissiveMesh {
     /// Emitted radiance (scene units), the same in every direction of the front side.
@@ -38,6 +41,8 @@ pub struct EmissiveMesh {
     transform: Option<Transform>,
     /// Cumulative world-space triangle areas, from 0; the last entry is the total area.
     cdf: Vec<f32>,
+    /// Each triangle's world-space corners and unit normal on its emitting side, as a sample reads them.
+    tris: Vec<([Vec3; 3], Vec3)>,
 }
 
 impl std::fmt::Debug for EmissiveMesh {
@@ -60,12 +65,13 @@ impl EmissiveMesh {
         radiance: Color,
         object: u32,
     ) -> Option<Self> {
-        let mut light = EmissiveMesh { radiance, object, shape, transform, cdf: vec![0.0] };
+        let mut light = EmissiveMesh { radiance, object, shape, transform, cdf: vec![0.0], tris: Vec::new() };
         let mut total = 0.0f64;
         for i in 0..light.shape.mesh().len() {
             let [a, b, c] = light.world_triangle(i);
             total += 0.5 * (b - a).cross(c - a).length() as f64;
             light.cdf.push(total as f32);
+            light.tris.push(([a, b, c], light.normal([a, b, c])));
         }
         (total > 0.0 && total.is_finite()).then_some(light)
     }
@@ -105,16 +111,23 @@ impl Light for EmissiveMesh {
     fn sample(&self, p: Vec3, _n: Vec3, u: Vec2) -> Option<LightSample> {
         let area = self.area();
         let x = u.x * area;
-        // The first triangle whose upper end exceeds x: never one of zero area.
-        let i = self.cdf[1..].partition_point(|&c| c <= x).min(self.cdf.len() - 2);
+        // The first triangle whose upper end exceeds x: never one of zero area. The upper ends are
+        // sorted, so that is how many of them are at most x; a small light counts them without the
+        // binary search's unpredictable branches.
+        let ends = &self.cdf[1..];
+        let below = if ends.len() <= LINEAR_SEARCH {
+            ends.iter().filter(|&&c| c <= x).count()
+        } else {
+            ends.partition_point(|&c| c <= x)
+        };
+        let i = below.min(self.cdf.len() - 2);
         let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
         let ux = if hi > lo { ((x - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
-        let [a, b, c] = self.world_triangle(i);
+        let ([a, b, c], n) = self.tris[i];
         // Uniform on the triangle: barycentrics (1 - √ux, uy √ux).
         let s = ux.sqrt();
         let (b1, b2) = (1.0 - s, u.y * s);
         let q = b1 * a + b2 * b + (1.0 - b1 - b2) * c;
-        let n = self.normal([a, b, c]);
         let (wi, dist, pdf) = self.towards(p, q, n)?;
         Some(LightSample { wi, dist, irradiance: self.radiance / pdf, pdf })
     }
@@ -125,7 +138,7 @@ impl Light for EmissiveMesh {
             Some(t) => Ray::new(t.inv.transform_point3(p), t.inv.transform_vector3(wi)),
         };
         let Some(hit) = self.shape.intersect(&ray) else { return 0.0 };
-        let n = self.normal(self.world_triangle(hit.prim as usize));
+        let n = self.tris[hit.prim as usize].1;
         self.towards(p, p + hit.t * wi, n).map_or(0.0, |(_, _, pdf)| pdf)
     }
 
