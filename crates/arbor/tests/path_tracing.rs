@@ -89,6 +89,30 @@ fn path_white_furnace_gives_back_the_environment_times_the_albedo() {
 }
 
 #[test]
+fn path_white_furnace_of_a_mirror_with_a_diffuse_colour_gives_back_both_parts() {
+    // A mirror of reflectance 0.3 with a diffuse colour of 0.5 reflects 0.8 of a uniform environment: the
+    // bounce follows the diffuse part or the mirror in proportion to their weights, so with cosine
+    // sampling every sample is worth exactly 0.8; dropping either part gives 0.3 or 0.5.
+    let xml = scene_xml(0.5, "", "").replace(
+        r#"<Material id="1">"#,
+        r#"<Material id="1" type="mirror"><MirrorReflectance>0.3 0.3 0.3</MirrorReflectance>"#,
+    );
+    let scene = build(&xml, Some(white_environment()));
+    for options in option_sets() {
+        let film = path(&scene, options, 64, 1);
+        let px = &film.pixels;
+        let centre: Vec<f32> = (5..11).flat_map(|y| (5..11).map(move |x| px[y * 16 + x].x)).collect();
+        let m = centre.iter().sum::<f32>() / centre.len() as f32;
+        let exact = options.importance_sampling && !options.russian_roulette;
+        let tol = if exact { 1e-3 } else { 0.04 };
+        assert!((m - 0.8).abs() < tol, "{options:?}: centre mean {m}");
+        if exact {
+            assert!(centre.iter().all(|c| (c - 0.8).abs() < 1e-3), "{options:?}: {centre:?}");
+        }
+    }
+}
+
+#[test]
 fn path_variance_of_a_pixel_mean_falls_as_one_over_the_samples() {
     // A point light over the sphere on a floor: direct light by next event estimation, indirect light by
     // uniform bounces, so each sample is noisy.

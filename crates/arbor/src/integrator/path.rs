@@ -4,10 +4,13 @@
 //!
 //! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
 //!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
-//!   lobes, picked in proportion to its weight, as delta directions.
+//!   lobes, picked in proportion to its weight, as delta directions. A material with both (a mirror
+//!   with a diffuse colour, the course's usual kind) is a mixture: the bounce follows its BRDF or its
+//!   lobes, chosen in proportion to the two parts' weights (the BRDF's `k_d + k_s` against the lobes'),
+//!   and light sampling serves its BRDF part.
 //! - Light: an emitter (or the environment) met by a ray counts, unless next event estimation sampled it
 //!   already (the course: "discard its contribution"). With `NextEventEstimation`, every vertex of a
-//!   non-delta surface is lit by each light no ray can meet (point, spot, directional, the square area
+//!   surface with a BRDF part is lit by each light no ray can meet (point, spot, directional, the square area
 //!   light) and by one of the others, chosen in proportion to its power, each with a shadow ray; with
 //!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997). Without
 //!   it, as in the course's plain references, lights no ray can meet give nothing (their radiance matches
@@ -148,9 +151,32 @@ impl<'a> PathTracer<'a> {
             let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
             let brdf = path_brdf(m);
             let local = front || !m.transmits();
+            // A material may have both a BRDF and a specular layer (a mirror with a diffuse colour): the
+            // bounce follows the BRDF with probability `p_brdf`, in proportion to the two parts' weights,
+            // and the layer's lobes otherwise; light sampling serves the BRDF part wherever it is.
+            let has_brdf = local && (kd != Color::ZERO || ks != Color::ZERO);
+            let lobes = if m.layer.is_some() {
+                let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
+                m.specular_lobes(d, n)
+            } else {
+                Vec::new()
+            };
+            let lobe_total: f32 = lobes.iter().map(|lb| luminance(lb.weight)).sum();
+            let p_brdf = match (m.layer.is_some(), has_brdf) {
+                (false, _) => 1.0,
+                (true, false) => 0.0,
+                (true, true) => {
+                    let b = luminance(kd) + luminance(ks);
+                    if b + lobe_total > 0.0 {
+                        b / (b + lobe_total)
+                    } else {
+                        0.0
+                    }
+                }
+            };
 
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
-            if local && m.layer.is_none() && (kd != Color::ZERO || ks != Color::ZERO) {
+            if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
                 let mut direct = |i: usize, u: Vec2, chosen: f32, count: &mut u64| {
                     let light = &scene.lights[i];
@@ -162,7 +188,7 @@ impl<'a> PathTracer<'a> {
                         return;
                     }
                     let w = if o.mis && ls.pdf > 0.0 {
-                        power_heuristic(chosen * ls.pdf, self.bounce_pdf(ns, ls.wi))
+                        power_heuristic(chosen * ls.pdf, p_brdf * self.bounce_pdf(ns, ls.wi))
                     } else {
                         1.0
                     };
@@ -184,14 +210,14 @@ impl<'a> PathTracer<'a> {
                 break;
             }
             // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
-            let next = if m.layer.is_some() {
-                let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
-                let lobes = m.specular_lobes(d, n);
-                let total: f32 = lobes.iter().map(|lb| luminance(lb.weight)).sum();
+            // With a layer, one number picks the part and, rescaled, the lobe.
+            let part = if m.layer.is_some() { rng.next_f32() } else { 0.0 };
+            let next = if part >= p_brdf {
+                let total = lobe_total;
                 if total <= 0.0 {
                     break;
                 }
-                let mut pick = rng.next_f32() * total;
+                let mut pick = (part - p_brdf) / (1.0 - p_brdf) * total;
                 let Some(lobe) = lobes.iter().find(|lb| {
                     pick -= luminance(lb.weight);
                     pick < 0.0
@@ -199,6 +225,9 @@ impl<'a> PathTracer<'a> {
                     break;
                 };
                 beta *= lobe.weight * (total / luminance(lobe.weight));
+                if p_brdf > 0.0 {
+                    beta /= 1.0 - p_brdf;
+                }
                 last = None;
                 inside = m.medium_after(lobe, front, inside);
                 lobe.dir
@@ -213,7 +242,10 @@ impl<'a> PathTracer<'a> {
                     break;
                 }
                 beta *= brdf.f(kd, ks, wi, wo, ns) * (cos / pdf);
-                last = Some((s.p, pdf));
+                if p_brdf < 1.0 {
+                    beta /= p_brdf;
+                }
+                last = Some((s.p, p_brdf * pdf));
                 wi
             };
             if o.russian_roulette {
