@@ -294,6 +294,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             "render_ms": stats.time.as_secs_f64() * 1e3,
             "rays": stats.rays,
             "mrays_per_s": stats.mrays_per_s(),
+            "traversal_share": stats.traversal_share(),
             "threads": rayon::current_num_threads(),
             "triangles": scene.geometry.counts.triangles,
         }));
@@ -353,7 +354,7 @@ fn summary(
     };
     say!(
         "{}  {}x{}  {samples}  parse {:.1} ms  build {:.1} ms ({}, {} triangles, {} spheres, {} planes)  \
-         render {:.1} ms  {:.2} M rays  {:.2} Mrays/s",
+         render {:.1} ms  {:.2} M rays  {:.2} Mrays/s{}",
         path.display(),
         window.2 - window.0,
         window.3 - window.1,
@@ -365,7 +366,8 @@ fn summary(
         g.planes,
         stats.time.as_secs_f64() * 1e3,
         stats.rays as f64 / 1e6,
-        stats.mrays_per_s()
+        stats.mrays_per_s(),
+        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of thread time", f * 100.0))
     );
     let s = scene.geometry.accel_stats();
     say!(

@@ -31,7 +31,7 @@ use crate::accum::SampleSum;
 use crate::error::Result;
 use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
-use crate::integrator::{DebugIntegrator, DebugView, Integrator};
+use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
 use crate::renderer::Renderer;
 use crate::sampler::{pixel_offset, Rng};
 use crate::scene::Scene;
@@ -70,6 +70,11 @@ pub struct RenderOptions {
 pub struct RenderStats {
     /// Rays traced: camera, shadow and secondary.
     pub rays: u64,
+    /// The time the structure's queries took, summed over threads (estimated from a sample of them:
+    /// [`RayLog`]).
+    pub traversal: Duration,
+    /// The time the workers spent on tiles, summed over threads.
+    pub busy: Duration,
     /// Wall time.
     pub time: Duration,
     /// Samples per pixel of the full image (the stratification).
@@ -86,6 +91,13 @@ impl RenderStats {
     /// Millions of rays per second.
     pub fn mrays_per_s(&self) -> f64 {
         self.rays as f64 / self.time.as_secs_f64().max(1e-9) / 1e6
+    }
+
+    /// The share of the workers' time spent in the structure's queries (the rest is shading, sampling
+    /// and the render loop), or `None` when nothing was traced.
+    pub fn traversal_share(&self) -> Option<f64> {
+        (self.busy > Duration::ZERO && self.traversal > Duration::ZERO)
+            .then(|| (self.traversal.as_secs_f64() / self.busy.as_secs_f64()).min(1.0))
     }
 }
 
@@ -104,7 +116,7 @@ pub fn render(
     let mut film = Film::try_new(w, h)?;
     let (traced, stats, scale) = trace(scene, camera, opts, progress)?;
     let count = stats.samples.1 - stats.samples.0;
-    for ((x0, y0, tw), sums) in traced {
+    for ((x0, y0, tw), sums, _, _) in traced {
         for (k, s) in sums.into_iter().enumerate() {
             let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
             film.pixels[y * w as usize + x] = s.value(scale, count);
@@ -157,7 +169,7 @@ pub fn render_sums(
     let mut sums = sums_buffer(window)?;
     sums.resize(ww * (window.3 - window.1) as usize, SampleSum::default());
     let (traced, stats, scale) = trace(scene, camera, &opts, progress)?;
-    for ((x0, y0, tw), tile) in traced {
+    for ((x0, y0, tw), tile, _, _) in traced {
         for (k, s) in tile.into_iter().enumerate() {
             let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
             sums[y * ww + x] = s;
@@ -182,7 +194,7 @@ fn sums_buffer(window: (u32, u32, u32, u32)) -> Result<Vec<SampleSum>> {
 const SUM_BYTES: u64 = std::mem::size_of::<SampleSum>() as u64;
 
 /// Per-tile sums over the crop window: `((x0, y0, tile width), sums)`, the stats and the radiance scale.
-type Traced = Vec<((u32, u32, u32), Vec<SampleSum>)>;
+type Traced = Vec<((u32, u32, u32), Vec<SampleSum>, RayLog, Duration)>;
 
 fn trace(
     scene: &Scene,
@@ -211,7 +223,6 @@ fn trace(
     let total = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
     let is_cancelled = || opts.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed));
     let done = AtomicU64::new(0);
-    let rays = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
     let moving = scene.geometry.has_motion();
 
@@ -222,7 +233,8 @@ fn trace(
             // Every tile's sums are kept until the image is assembled: together, one per pixel.
             let mut pixels =
                 sums_buffer((x0, y0, x1, y1)).map_err(|_| out_of_memory(cx1 - cx0, cy1 - cy0, total * SUM_BYTES))?;
-            let mut count = 0u64;
+            let tile_start = Instant::now();
+            let mut log = RayLog::default();
             let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
@@ -249,32 +261,39 @@ fn trace(
                 }
                 if debug.is_none() {
                     hits.resize(batch.len(), None);
-                    scene.geometry.intersect_many(&batch, f32::INFINITY, &mut hits);
+                    log.intersect_many(&scene.geometry, &batch, f32::INFINITY, &mut hits);
                 }
                 for p in 0..group.len() {
                     let mut sum = SampleSum::default();
                     for s in p * samples..(p + 1) * samples {
                         sum.add_sample(match &debug {
                             Some(d) => {
-                                count += 1;
+                                log.rays += 1;
                                 d.li_camera(&batch[s])
                             }
-                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut rngs[s], &mut count),
+                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut rngs[s], &mut log),
                         });
                     }
                     pixels.push(sum);
                 }
             }
-            rays.fetch_add(count, Ordering::Relaxed);
             let n = done.fetch_add(pixels.len() as u64, Ordering::Relaxed) + pixels.len() as u64;
             progress(n, total);
-            Ok(((x0, y0, x1 - x0), pixels))
+            Ok(((x0, y0, x1 - x0), pixels, log, tile_start.elapsed()))
         })
         .collect();
     let traced = traced?;
     let cancelled = is_cancelled();
+    let mut log = RayLog::default();
+    let mut busy = Duration::ZERO;
+    for (_, _, l, t) in &traced {
+        log.merge(l);
+        busy += *t;
+    }
     let stats = RenderStats {
-        rays: rays.into_inner(),
+        rays: log.rays,
+        traversal: log.traversal(),
+        busy,
         time: start.elapsed(),
         spp,
         samples: (k0, k1),

@@ -3,10 +3,12 @@
 pub mod debug;
 pub mod offset;
 mod path;
+mod ray_log;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};
 pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
+pub use ray_log::{RayLog, TIMED_EVERY};
 pub use whitted::Whitted;
 
 use crate::accel::Hit;
@@ -43,10 +45,10 @@ impl<'a> Integrator<'a> {
     }
 
     /// Radiance along the camera ray `ray` (from [`Integrator::camera_ray`]) whose closest hit is `hit`.
-    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
         match self {
-            Integrator::Whitted(w) => w.li_camera_hit(ray, hit, rng, count),
-            Integrator::Path(p) => p.li_camera_hit(ray, hit, rng, count),
+            Integrator::Whitted(w) => w.li_camera_hit(ray, hit, rng, log),
+            Integrator::Path(p) => p.li_camera_hit(ray, hit, rng, log),
         }
     }
 }

@@ -26,6 +26,7 @@
 //! value depends only on its random stream.
 
 use super::offset::{shadow_ray, spawn_origin};
+use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::material::{beer, Brdf, BrdfModel, Material};
@@ -105,8 +106,8 @@ impl<'a> PathTracer<'a> {
     }
 
     /// Radiance (in the scene's units) along the camera ray `ray`, whose closest hit is `hit`.
-    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
-        *count += 1;
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
+        log.rays += 1;
         let scene = self.scene;
         let o = self.options;
         let (mut ray, mut hit) = (*ray, hit);
@@ -178,13 +179,13 @@ impl<'a> PathTracer<'a> {
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
             if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
-                let mut direct = |i: usize, u: Vec2, chosen: f32, count: &mut u64| {
+                let mut direct = |i: usize, u: Vec2, chosen: f32, log: &mut RayLog| {
                     let light = &scene.lights[i];
                     let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
-                    *count += 1;
+                    log.rays += 1;
                     let on_surface = light.object().is_some();
                     let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, on_surface);
-                    if scene.geometry.occluded(&shadow.with_time(ray.time), t_max) {
+                    if log.occluded(&scene.geometry, &shadow.with_time(ray.time), t_max) {
                         return;
                     }
                     let w = if o.mis && ls.pdf > 0.0 {
@@ -198,10 +199,10 @@ impl<'a> PathTracer<'a> {
                 let (pick, u) = (rng.next_f32(), rng.next_2d());
                 if o.next_event {
                     for i in (0..scene.lights.len()).filter(|&i| self.pick[i] == 0.0) {
-                        direct(i, rng.next_2d(), 1.0, count);
+                        direct(i, rng.next_2d(), 1.0, log);
                     }
                     if let Some((i, chosen)) = self.choose_light(pick) {
-                        direct(i, u, chosen, count);
+                        direct(i, u, chosen, log);
                     }
                 }
             }
@@ -261,8 +262,8 @@ impl<'a> PathTracer<'a> {
             bounce += 1;
             let origin = spawn_origin(scene.offset, &s, next);
             ray = Ray::new(origin, next).with_time(ray.time);
-            *count += 1;
-            hit = scene.geometry.intersect(&ray, f32::INFINITY);
+            log.rays += 1;
+            hit = log.intersect(&scene.geometry, &ray, f32::INFINITY);
         }
         l
     }

@@ -21,6 +21,7 @@
 //! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
 //! lights their [`crate::light::Light::sample`], never the description.
 
+use super::RayLog;
 use super::offset::{shadow_ray, spawn_origin};
 use crate::accel::Hit;
 use crate::camera::{Camera, RayCone};
@@ -61,8 +62,8 @@ impl<'a> Whitted<'a> {
     }
 
     /// Radiance (in the scene's units) along a camera ray.
-    pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, count: &mut u64) -> Color {
-        self.li(&self.camera_ray(ray), self.camera_carried(), rng, count)
+    pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, log: &mut RayLog) -> Color {
+        self.li(&self.camera_ray(ray), self.camera_carried(), rng, log)
     }
 
     /// The camera ray as it is traced: culling back faces if the render asks for it.
@@ -73,9 +74,9 @@ impl<'a> Whitted<'a> {
     /// [`Whitted::li_camera`] for a camera ray already traced (with others, by
     /// [`crate::scene::SceneGeometry::intersect_many`]): `ray` is [`Whitted::camera_ray`]'s and `hit` its
     /// closest hit.
-    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, count: &mut u64) -> Color {
-        *count += 1;
-        self.shade(ray, hit, self.camera_carried(), rng, count)
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
+        log.rays += 1;
+        self.shade(ray, hit, self.camera_carried(), rng, log)
     }
 
     fn camera_carried(&self) -> Carried {
@@ -83,14 +84,14 @@ impl<'a> Whitted<'a> {
     }
 
     /// Radiance along `ray`.
-    fn li(&self, ray: &Ray, carried: Carried, rng: &mut Rng, count: &mut u64) -> Color {
-        *count += 1;
-        let hit = self.scene.geometry.intersect(ray, f32::INFINITY);
-        self.shade(ray, hit, carried, rng, count)
+    fn li(&self, ray: &Ray, carried: Carried, rng: &mut Rng, log: &mut RayLog) -> Color {
+        log.rays += 1;
+        let hit = log.intersect(&self.scene.geometry, ray, f32::INFINITY);
+        self.shade(ray, hit, carried, rng, log)
     }
 
     /// Radiance along `ray` given its closest hit.
-    fn shade(&self, ray: &Ray, hit: Option<Hit>, carried: Carried, rng: &mut Rng, count: &mut u64) -> Color {
+    fn shade(&self, ray: &Ray, hit: Option<Hit>, carried: Carried, rng: &mut Rng, log: &mut RayLog) -> Color {
         let Carried { depth, inside, cone } = carried;
         let scene = self.scene;
         let Some(hit) = hit else {
@@ -131,11 +132,11 @@ impl<'a> Whitted<'a> {
             if ns.dot(ls.wi) <= 0.0 {
                 continue;
             }
-            *count += scene.shadows as u64;
+            log.rays += scene.shadows as u64;
             let on_surface = light.object().is_some();
             let (shadow, t_max) = shadow_ray(scene.offset, shadow_origin, s.p, &ls, on_surface);
             let shadow = shadow.with_time(ray.time);
-            if scene.shadows && scene.geometry.occluded(&shadow, t_max) {
+            if scene.shadows && log.occluded(&scene.geometry, &shadow, t_max) {
                 continue;
             }
             color += terms.eval_cos(ns, ls.wi, wo) * ls.irradiance;
@@ -158,7 +159,7 @@ impl<'a> Whitted<'a> {
                 let origin = spawn_origin(scene.offset, &s, side);
                 let next_inside = m.medium_after(&lobe, front, inside);
                 let next = Carried { depth: depth + 1, inside: next_inside, cone: cone.after(hit.t * d.length()) };
-                let l = self.li(&Ray::new(origin, dir).with_time(ray.time), next, rng, count);
+                let l = self.li(&Ray::new(origin, dir).with_time(ray.time), next, rng, log);
                 color += lobe.weight * l;
             }
         }
