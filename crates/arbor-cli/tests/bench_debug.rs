@@ -52,6 +52,7 @@ fn bench_json_is_valid_and_complete() {
     }
     assert!(rows[1]["primary"]["speedup"].as_f64().unwrap() > 1.0, "{}", rows[1]);
     assert_eq!(doc["rays"]["primary"]["rays"], 1200);
+    assert!(["avx2", "sse", "scalar"].contains(&doc["kernel"].as_str().unwrap()), "{}", doc["kernel"]);
 }
 
 #[test]
@@ -137,6 +138,8 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
         assert!(fields[3].starts_with("build_ms=") && fields[4].starts_with("mrays="), "{line}");
         assert_eq!(fields[5], "hits=2", "{line}");
         assert!(line.contains("mismatch=0.333333"), "{line}");
+        let kernel = line.split_whitespace().find_map(|f| f.strip_prefix("kernel=")).unwrap_or("");
+        assert!(["avx2", "sse", "scalar"].contains(&kernel), "{line}");
     }
 
     // --rays picks the sets of the folder: the primary files are not even read.

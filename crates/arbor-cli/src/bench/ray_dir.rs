@@ -61,6 +61,8 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), Failure> {
         load.as_secs_f64() * 1e3,
         bytes as f64 / load.as_secs_f64().max(1e-9) / 1e6
     );
+    let kernel = arbor::accel::bvh::query_kernel();
+    say!("# kernel={kernel} (the BVH's node test, detected at run time; processor: {})", cpu_features());
     let sets: Vec<RaySetFile> = ["primary", "diffuse"]
         .into_iter()
         .filter(|name| args.rays.has(name))
@@ -98,7 +100,7 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), Failure> {
                 say!(
                     "peer=arbor-{}{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} \
                      tris={} rays={} runs={} vs=reference mismatch={:.6} cpu_build_ms={cpu_build_ms:.2} \
-                     cpu_mrays={:.3}",
+                     cpu_mrays={:.3} kernel={kernel}",
                     spec.kind(),
                     mode.suffix(),
                     set.name,
@@ -207,6 +209,24 @@ fn trace_all(
             .zip(batch.rays.par_chunks(CHUNK))
             .zip(batch.t_max.par_chunks(CHUNK))
             .for_each(|((o, r), t)| trace(r, t, o));
+    }
+}
+
+/// The processor's SIMD extensions that a wider kernel could use, e.g. `avx2=yes avx512f=no`.
+pub(super) fn cpu_features() -> String {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let yes = |b: bool| if b { "yes" } else { "no" };
+        format!(
+            "avx2={} fma={} avx512f={}",
+            yes(std::is_x86_feature_detected!("avx2")),
+            yes(std::is_x86_feature_detected!("fma")),
+            yes(std::is_x86_feature_detected!("avx512f"))
+        )
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        std::env::consts::ARCH.to_string()
     }
 }
 

@@ -173,6 +173,11 @@ fn print_table(
     rows: &[(AccelStats, Vec<SetResult>)],
 ) {
     say!("input      {} ({prims} primitives), {} threads", args.input, rayon::current_num_threads());
+    say!(
+        "kernel     {} (the BVH's node test, detected at run time; processor: {})",
+        arbor::accel::bvh::query_kernel(),
+        super::ray_dir::cpu_features()
+    );
     for (set, b) in sets.iter().zip(brute) {
         say!(
             "rays       {}: {} ({} hit by {REFERENCE}); brute force traces a sample of {}{}",
@@ -288,6 +293,7 @@ fn print_json(
         "input": args.input,
         "primitives": prims,
         "threads": rayon::current_num_threads(),
+        "kernel": arbor::accel::bvh::query_kernel(),
         "reference": REFERENCE.name(),
         "runs": args.runs,
         "rays": rays,

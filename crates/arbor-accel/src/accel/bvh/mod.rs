@@ -49,6 +49,12 @@ use crate::math::{Aabb, Ray, Vec3};
 /// above it is split in the middle of its index range.
 pub const LEAF_HARD_MAX: usize = 64;
 
+/// The node-test kernel the wide BVH's queries run on this processor, detected at run time: `avx2`
+/// (8 lanes at once; the whole query is compiled for AVX2), `sse` (two 4-lane halves) or `scalar`.
+pub fn query_kernel() -> &'static str {
+    wide::Kernel::detect().name()
+}
+
 /// Every node's depth (root at depth 0) is below this, which sizes the traversal stack. From depth 64
 /// on, the SAH builder stops looking for SAH splits and halves index ranges, and the bottom-up builder
 /// rebuilds subtrees that are still too deep with the median split; either adds at most 32 levels.

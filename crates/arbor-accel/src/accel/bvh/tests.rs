@@ -562,3 +562,15 @@ mod scalar_path {
         }
     }
 }
+
+#[test]
+fn query_kernel_names_the_detected_kernel() {
+    let names: Vec<&str> = kernels().into_iter().map(|k| k.name()).collect();
+    assert_eq!(names[0], "scalar");
+    #[cfg(all(target_arch = "x86_64", not(miri)))]
+    {
+        let expected = if super::wide::Avx2::detect().is_some() { "avx2" } else { "sse" };
+        assert_eq!(super::query_kernel(), expected);
+        assert_eq!(&names[1..], if expected == "avx2" { &["sse", "avx2"][..] } else { &["sse"][..] });
+    }
+}

@@ -72,6 +72,17 @@ impl Kernel {
         #[cfg(any(not(target_arch = "x86_64"), miri))]
         Kernel::Scalar
     }
+
+    /// The kernel's name, as benchmarks report it: `avx2`, `sse` or `scalar`.
+    pub fn name(self) -> &'static str {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2(_) => "avx2",
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Sse => "sse",
+            Kernel::Scalar => "scalar",
+        }
+    }
 }
 
 /// What a node test returns: the lanes whose box the ray meets in `[0, t_far]` (bit per lane), their

@@ -47,7 +47,8 @@ pub(super) use closest::intersect;
 #[cfg(test)]
 pub(super) use closest::intersect_with;
 #[cfg(test)]
-pub(super) use kernel::{Avx2, Kernel};
+pub(super) use kernel::Avx2;
+pub(super) use kernel::Kernel;
 
 use super::Node;
 use crate::accel::Primitives;
