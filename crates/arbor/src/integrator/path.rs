@@ -10,8 +10,8 @@
 //!   and light sampling serves its BRDF part.
 //! - Light: an emitter (or the environment) met by a ray counts, unless next event estimation sampled it
 //!   already (the course: "discard its contribution"). With `NextEventEstimation`, every vertex of a
-//!   surface with a BRDF part is lit by each light no ray can meet (point, spot, directional, the square area
-//!   light) and by one of the others, chosen in proportion to its power, each with a shadow ray; with
+//!   surface with a BRDF part is lit by each light no ray can meet (point, spot, directional, the square
+//!   area light) and by one of the others, chosen in proportion to its power, each with a shadow ray; with
 //!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997). Without
 //!   it, as in the course's plain references, lights no ray can meet give nothing (their radiance matches
 //!   Arbor's within 1% that way). After a delta lobe, met light always counts in full.
