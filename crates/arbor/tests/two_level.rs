@@ -200,24 +200,39 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
 
 #[test]
 fn two_level_batches_give_every_ray_its_own_querys_hit() {
-    // One transformed mesh with a plane beside it (its batch traced through the mesh at once), a few
-    // objects and a random scene of many (each ray walks the top level); invalid rays mixed in.
+    // One transformed mesh with a plane beside it, a few large objects (both swept object by object), a
+    // few small ones and a random scene of many (each ray walks the top level); invalid rays mixed in.
     let mut rng = Lcg(23);
     let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
     let indices: Vec<[u32; 3]> = (0..200).map(|k| [k * 3 % 300, (k * 3 + 1) % 300, (k * 3 + 2) % 300]).collect();
     let mesh = Arc::new(TriangleMesh { positions, indices, ..Default::default() });
     let t = Transform::translate(Vec3::new(1.0, 2.0, 0.5)).then(&Transform::rotate(30.0, Vec3::Y).unwrap());
+    let inline = |m: &Arc<TriangleMesh>| ShapeDesc::Mesh { source: MeshSource::Inline(m.clone()), smooth: false };
     let one_mesh = desc(vec![
-        object("Mesh", ShapeDesc::Mesh { source: MeshSource::Inline(mesh), smooth: false }, t),
+        object("Mesh", inline(&mesh), t),
         object("Plane", ShapeDesc::Plane { point: Vec3::new(0.0, -1.5, 0.0), normal: Vec3::Y }, Transform::IDENTITY),
     ]);
-    // Few objects: meshes, instances and spheres, plus an instance in the very place of the first mesh,
-    // whose hits tie with it and must go to the first.
+    // Few large objects: two meshes, an instance in the very place of the first, whose hits tie with it
+    // and must go to the first, and a sphere.
+    let big = |rng: &mut Lcg| {
+        let positions: Vec<Vec3> = (0..1800).map(|_| rng.v(4.0)).collect();
+        let indices: Vec<[u32; 3]> = (0..600).map(|k| [k * 3, k * 3 + 1, k * 3 + 2]).collect();
+        Arc::new(TriangleMesh { positions, indices, ..Default::default() })
+    };
+    let u = Transform::translate(Vec3::new(-2.0, 0.0, 1.0));
+    let few_large = desc(vec![
+        object("Mesh", inline(&big(&mut rng)), t),
+        object("Mesh", inline(&big(&mut rng)), u),
+        object("MeshInstance", ShapeDesc::Instance { base: 0 }, t),
+        object("Sphere", ShapeDesc::Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 1.5 }, Transform::IDENTITY),
+    ]);
+    // Few small objects: meshes, instances and spheres, and again an instance where the first mesh is.
     let mut few = random_scene(&mut rng);
     few.objects.truncate(6);
     let same_place = few.objects[0].transform;
     few.objects.push(object("MeshInstance", ShapeDesc::Instance { base: 0 }, same_place));
-    for d in [one_mesh, few, random_scene(&mut rng)] {
+    let sweeps = [true, true, false, false];
+    for (d, sweep) in [one_mesh, few_large, few, random_scene(&mut rng)].into_iter().zip(sweeps) {
         // Aimed at the middle of the scene, where its objects are.
         let mut rays: Vec<Ray> = (0..3_000)
             .map(|_| {
@@ -229,6 +244,7 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         rays[11] = Ray::new(Vec3::ZERO, Vec3::ZERO);
         for &kind in AccelKind::ALL {
             let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
+            assert_eq!(g.sweeps(), sweep, "{kind}: {} objects", g.objects.objects.len());
             for t_max in [f32::INFINITY, 20.0] {
                 let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
                 assert!(single.iter().filter(|h| h.is_some()).count() > 200, "{kind}: the rays must hit");

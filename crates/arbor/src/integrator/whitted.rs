@@ -21,8 +21,8 @@
 //! It reads the runtime scene only: materials ask their [`crate::material::SpecularLayer`] for lobes,
 //! lights their [`crate::light::Light::sample`], never the description.
 
-use super::RayLog;
 use super::offset::{shadow_ray, spawn_origin};
+use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::{Camera, RayCone};
 use crate::material::{beer, perturb, Material};

@@ -22,6 +22,14 @@ use crate::accel::{Accel, AccelStats, Hit, PrimHit, Primitives, TraversalCounts}
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 
+/// Scenes of at most this many bounded objects trace batches object by object
+/// ([`SceneGeometry::intersect_many`]), every ray meeting every object's root ...
+pub const SWEEP_OBJECTS: usize = 8;
+/// ... when they hold this many triangles per object on average: a large mesh traced by a whole batch
+/// (two rays at a time) gains more than the rays with no business in it cost, while small objects (a
+/// Cornell box's walls) are cheaper left to the top level's boxes.
+pub const SWEEP_MEAN_TRIANGLES: usize = 256;
+
 /// A mesh in object space under its own structure; shared by every object that shows it.
 pub struct MeshShape {
     /// Triangles in object space; `normals` are set for smooth shading only.
@@ -215,30 +223,59 @@ impl SceneGeometry {
     /// [`SceneGeometry::intersect`] for a batch (the camera rays of a few pixels): `out[i]` becomes
     /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
     ///
-    /// A scene of one bounded mesh traces the whole batch through the mesh's structure at once
-    /// ([`Accel::intersect_many`], which the BVH traces two rays at a time). With more objects each ray
-    /// walks the top level on its own, whose boxes keep it out of the objects it does not come near:
-    /// sweeping every object with the batch costs more as soon as a ray would skip one.
+    /// A scene of a few large meshes ([`SceneGeometry::sweeps`]) is swept object by object, each mesh
+    /// tracing the whole batch ([`Accel::intersect_many`]) up to the closest hit so far, which a later
+    /// object must beat strictly (ties go to the lowest object, as at the top level); otherwise each ray
+    /// walks the top level on its own.
     ///
     /// # Panics
     /// When `rays` and `out` differ in length.
     pub fn intersect_many(&self, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
-        let [object @ SceneObject { shape: Shape::Mesh(m), .. }] = self.objects.objects.as_slice() else {
+        if !self.sweeps() {
             for (o, r) in out.iter_mut().zip(rays) {
                 *o = self.intersect(r, t_max);
             }
             return;
-        };
-        let local: Vec<Ray> = rays.iter().map(|r| object.local_ray(r)).collect();
-        let limit = vec![t_max; rays.len()];
-        let mut found = vec![None; rays.len()];
-        m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
-        // An invalid ray hits nothing, planes included, as in `intersect`.
-        for ((o, r), h) in out.iter_mut().zip(rays).zip(found) {
-            let best = h.map(|h| Hit::new(0, nested(h)));
-            *o = if r.is_valid() { self.intersect_planes(r, t_max, best, None) } else { None };
         }
+        out.fill(None);
+        let mut limit = vec![t_max; rays.len()];
+        let (mut local, mut found) = (Vec::new(), Vec::new());
+        for (i, object) in self.objects.objects.iter().enumerate() {
+            match &object.shape {
+                Shape::Mesh(m) => {
+                    local.clear();
+                    local.extend(rays.iter().map(|r| object.local_ray(r)));
+                    found.resize(rays.len(), None);
+                    m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
+                    for ((o, l), h) in out.iter_mut().zip(&mut limit).zip(&found) {
+                        if let Some(h) = h {
+                            *o = Some(Hit::new(i as u32, nested(*h)));
+                            *l = h.t;
+                        }
+                    }
+                }
+                Shape::Sphere(_) => {
+                    for ((o, l), r) in out.iter_mut().zip(&mut limit).zip(rays) {
+                        if let Some(h) = self.objects.intersect(i, r, *l) {
+                            *o = Some(Hit::new(i as u32, h));
+                            *l = h.t;
+                        }
+                    }
+                }
+            }
+        }
+        // An invalid ray hits nothing, planes included, as in `intersect`.
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = if r.is_valid() { self.intersect_planes(r, t_max, *o, None) } else { None };
+        }
+    }
+
+    /// Whether [`SceneGeometry::intersect_many`] sweeps the objects: one, or a few large ones
+    /// ([`SWEEP_OBJECTS`]).
+    pub fn sweeps(&self) -> bool {
+        let n = self.objects.objects.len();
+        n == 1 || (n <= SWEEP_OBJECTS && self.counts.triangles >= n * SWEEP_MEAN_TRIANGLES)
     }
 
     /// [`SceneGeometry::intersect`], adding the nodes visited and primitives tested at both levels to

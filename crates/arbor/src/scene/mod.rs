@@ -14,7 +14,10 @@ mod runtime;
 
 pub use build::{build_camera, build_geometry};
 pub use desc::*;
-pub use geometry::{MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape};
+pub use geometry::{
+    MeshShape, SceneCounts, SceneGeometry, SceneObject, SceneObjects, ScenePlane, Shape, SWEEP_MEAN_TRIANGLES,
+    SWEEP_OBJECTS,
+};
 pub use limits::{check_limits, SceneLimits};
 pub use readers::{load_desc, parse_desc};
 pub use runtime::{RayOffset, Scene, Surface};
