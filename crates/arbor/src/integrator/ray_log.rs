@@ -13,7 +13,7 @@ use crate::math::Ray;
 use crate::scene::SceneGeometry;
 
 /// One query in this many is timed.
-pub const TIMED_EVERY: u32 = 16;
+pub const TIMED_EVERY: u32 = 64;
 
 /// Rays traced by one worker and the sampled time of their queries.
 #[derive(Debug, Clone, Default)]
@@ -90,17 +90,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn ray_log_times_one_query_in_sixteen_and_scales_it_up() {
+    fn ray_log_times_one_query_in_sixty_four_and_scales_it_up() {
         let mut log = RayLog::default();
-        let answers: Vec<u32> = (0..64).map(|i| log.query(|| i)).collect();
-        assert_eq!(answers, (0..64).collect::<Vec<_>>(), "every query's answer comes back");
-        assert_eq!((log.queries, log.timed_queries), (64, 4));
-        // Four timed queries stand for 64: their time, less the clock's, is scaled by 16.
+        let answers: Vec<u32> = (0..256).map(|i| log.query(|| i)).collect();
+        assert_eq!(answers, (0..256).collect::<Vec<_>>(), "every query's answer comes back");
+        assert_eq!((log.queries, log.timed_queries), (256, 4));
+        // Four timed queries stand for 256: their time, less the clock's, is scaled by 64.
         log.timed = Duration::from_micros(10);
-        assert_eq!(log.traversal(), (Duration::from_micros(10) - clock_cost() * 4) * 16);
+        assert_eq!(log.traversal(), (Duration::from_micros(10) - clock_cost() * 4) * 64);
         let mut sum = RayLog { rays: 3, ..RayLog::default() };
         sum.merge(&log);
-        assert_eq!((sum.rays, sum.queries, sum.timed_queries, sum.timed), (3, 64, 4, log.timed));
+        assert_eq!((sum.rays, sum.queries, sum.timed_queries, sum.timed), (3, 256, 4, log.timed));
         assert_eq!(RayLog::default().traversal(), Duration::ZERO);
     }
 }
