@@ -193,7 +193,8 @@ fn sums_buffer(window: (u32, u32, u32, u32)) -> Result<Vec<SampleSum>> {
 /// Bytes of one pixel's exact sample sums.
 const SUM_BYTES: u64 = std::mem::size_of::<SampleSum>() as u64;
 
-/// Per-tile sums over the crop window: `((x0, y0, tile width), sums)`, the stats and the radiance scale.
+/// Per-tile sums over the crop window: `((x0, y0, tile width), sums, the tile's rays, its time)`, the stats
+/// and the radiance scale.
 type Traced = Vec<((u32, u32, u32), Vec<SampleSum>, RayLog, Duration)>;
 
 fn trace(
