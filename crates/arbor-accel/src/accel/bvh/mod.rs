@@ -12,7 +12,13 @@
 //! second child's index is stored. Leaves hold a range of [`Bvh::prim_indices`], the primitive indices
 //! reordered so that every leaf's primitives are contiguous.
 //!
-//! Invariants (checked by [`Accel::validate`], which the factory runs in debug builds):
+//! Over a triangle mesh the wide tree's leaves hold their own copies of the triangles and their
+//! indices, so the build drops the binary tree and the index array once collapsed, keeping the root
+//! box and the statistics taken before; the boxes debug view then shows the wide tree's boxes (the
+//! root's, then each wide node's child boxes), and [`Accel::validate`] checks the wide tree
+//! (`wide/check.rs`). Other primitives keep both: their leaves read the index array.
+//!
+//! Invariants of the binary tree (checked by [`Accel::validate`], which the factory runs in debug builds):
 //! - every node's box encloses its children's boxes and its primitives' boxes;
 //! - every primitive index appears exactly once in [`Bvh::prim_indices`]; the first `live` are reachable
 //!   from the root through leaves whose ranges tile `0..live` in depth-first order, the rest are
@@ -24,7 +30,8 @@
 //! Cost: the SAH and median builds are O(n log n) (one binning or selection pass per level), with the
 //! two halves of large nodes built in parallel; PLOC is O(n log n) in practice, the greedy method
 //! O(n²) (see their modules). No result depends on the thread count. A query is O(log n) on
-//! well-distributed scenes; memory is 32 bytes per node (about `2n / leaf size` nodes) plus 4 bytes per primitive.
+//! well-distributed scenes; while kept, the binary tree takes 32 bytes per node (about `2n / leaf size`
+//! nodes) plus 4 bytes per primitive, on top of the wide tree.
 
 mod bottom_up;
 mod build;
@@ -110,13 +117,29 @@ impl Node {
     }
 }
 
+/// Whether a BVH over a triangle mesh keeps its binary tree and index array after the collapse: its
+/// queries read only the wide tree and its triangle blocks, so the public builders drop them; tests
+/// that inspect the binary tree keep it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Binary {
+    DropForMesh,
+    #[cfg(test)]
+    Keep,
+}
+
 /// A bounding volume hierarchy over primitive indices.
 #[derive(Debug, Clone)]
 pub struct Bvh {
+    /// Empty (with `prim_indices`) once dropped, see [`Binary`].
     nodes: Vec<Node>,
     prim_indices: Vec<u32>,
     live: usize,
+    primitives: usize,
+    bounds: Aabb,
     wide: Wide,
+    /// The binary tree's statistics, taken before it was dropped (`bytes` and `build_time` are filled
+    /// in when asked); `None` while the tree is kept, whose statistics are computed when asked.
+    dropped_stats: Option<AccelStats>,
     kind: &'static str,
     build_time: Duration,
 }
@@ -124,33 +147,45 @@ pub struct Bvh {
 impl Bvh {
     /// Builds a BVH over `prims` with binned SAH splits.
     pub fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -> Bvh {
+        Bvh::sah(prims, params, Binary::DropForMesh)
+    }
+
+    pub(crate) fn sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams, binary: Binary) -> Bvh {
         let start = Instant::now();
         let mut params = params.sanitized();
         if prims.triangle_mesh().is_none() {
             params.leaf_block = 1;
         }
         let (nodes, prim_indices, live) = sah::build_sah(prims, &params);
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start)
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start, binary)
     }
 
     /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
     /// `median.rs`).
     pub fn build_median<P: Primitives + ?Sized>(prims: &P, params: &MedianParams) -> Bvh {
+        Bvh::median(prims, params, Binary::DropForMesh)
+    }
+
+    pub(crate) fn median<P: Primitives + ?Sized>(prims: &P, params: &MedianParams, binary: Binary) -> Bvh {
         let start = Instant::now();
         let bvh_params = BvhParams { max_leaf_prims: params.max_leaf_prims, ..BvhParams::default() };
         let (nodes, prim_indices, live) = median::build_median(prims, &bvh_params.sanitized());
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-median", start)
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-median", start, binary)
     }
 
     /// Builds a BVH over `prims` bottom-up, by the exact greedy method or PLOC (see `bottom_up/`).
     pub fn build_bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams) -> Bvh {
-        let start = Instant::now();
-        let (nodes, prim_indices, live) = bottom_up::build(prims, params);
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-bottom-up", start)
+        Bvh::bottom_up(prims, params, Binary::DropForMesh)
     }
 
-    /// Wraps a flat node array written by any builder (the traversal and checks are shared), and
-    /// records the build time since `start`.
+    pub(crate) fn bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams, binary: Binary) -> Bvh {
+        let start = Instant::now();
+        let (nodes, prim_indices, live) = bottom_up::build(prims, params);
+        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-bottom-up", start, binary)
+    }
+
+    /// Wraps a flat node array written by any builder (the traversal and checks are shared), collapses
+    /// it, drops it for a mesh unless told to keep it, and records the build time since `start`.
     pub(crate) fn from_flat<P: Primitives + ?Sized>(
         prims: &P,
         nodes: Vec<Node>,
@@ -158,18 +193,51 @@ impl Bvh {
         live: usize,
         kind: &'static str,
         start: Instant,
+        binary: Binary,
     ) -> Bvh {
         let wide = Wide::collapse(&nodes, &prim_indices, prims);
-        // Statistics are computed when asked for (a walk over every node): not part of the build.
-        Bvh { nodes, prim_indices, live, wide, kind, build_time: start.elapsed() }
+        let bounds = nodes.first().map_or(Aabb::EMPTY, Node::bounds);
+        let primitives = prim_indices.len();
+        let mut bvh = Bvh {
+            nodes,
+            prim_indices,
+            live,
+            primitives,
+            bounds,
+            wide,
+            dropped_stats: None,
+            kind,
+            build_time: Duration::ZERO,
+        };
+        if binary == Binary::DropForMesh && bvh.wide.has_blocks() {
+            // The statistics describe the binary tree, so they are taken now, as part of the build.
+            bvh.dropped_stats = Some(bvh.compute_stats(kind, Duration::ZERO));
+            bvh.nodes = Vec::new();
+            bvh.prim_indices = Vec::new();
+        }
+        // Otherwise statistics are computed when asked for (a walk over every node): not part of the build.
+        bvh.build_time = start.elapsed();
+        bvh
     }
 
-    /// The flat node array; node 0 is the root (empty when no primitive can be hit).
+    /// True when the binary tree and the index array were dropped after the collapse (a mesh BVH from
+    /// the public builders): [`Bvh::nodes`] and [`Bvh::prim_indices`] are then empty.
+    pub fn binary_dropped(&self) -> bool {
+        self.dropped_stats.is_some()
+    }
+
+    /// The 8-wide tree that queries traverse.
+    pub fn wide(&self) -> &Wide {
+        &self.wide
+    }
+
+    /// The flat node array; node 0 is the root (empty when no primitive can be hit, or when dropped:
+    /// see [`Bvh::binary_dropped`]).
     pub fn nodes(&self) -> &[Node] {
         &self.nodes
     }
 
-    /// Primitive indices in leaf order; leaves refer to ranges of it.
+    /// Primitive indices in leaf order; leaves refer to ranges of it (empty when dropped).
     pub fn prim_indices(&self) -> &[u32] {
         &self.prim_indices
     }
@@ -179,6 +247,9 @@ impl Bvh {
             + self.nodes.len() * std::mem::size_of::<Node>()
             + self.prim_indices.len() * std::mem::size_of::<u32>()
             + self.wide.bytes();
+        if let Some(s) = &self.dropped_stats {
+            return AccelStats { bytes, build_time, ..s.clone() };
+        }
         let mut tally = StatsTally::new(kind, self.prim_indices.len(), self.nodes.len(), bytes, build_time);
         let Some(root) = self.nodes.first() else {
             return tally.finish();
@@ -210,7 +281,7 @@ impl Bvh {
 
 impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, Node::bounds)
+        self.bounds
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
@@ -226,6 +297,9 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+        if self.binary_dropped() {
+            return self.wide.boxes_at_depth(self.bounds, depth);
+        }
         let mut out = Vec::new();
         let mut stack = if self.nodes.is_empty() { vec![] } else { vec![(0usize, 0usize)] };
         while let Some((i, d)) = stack.pop() {
@@ -249,7 +323,13 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn validate(&self, prims: &P) -> Result<(), String> {
-        validate::validate(&self.nodes, &self.prim_indices, self.live, prims)
+        if !self.binary_dropped() {
+            validate::validate(&self.nodes, &self.prim_indices, self.live, prims)?;
+        }
+        match prims.triangle_mesh() {
+            Some(mesh) if self.wide.has_blocks() => self.wide.validate(mesh, self.primitives, self.live, self.bounds),
+            _ => Ok(()),
+        }
     }
 }
 

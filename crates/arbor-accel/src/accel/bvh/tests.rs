@@ -55,7 +55,7 @@ fn bvh_empty_set_hits_nothing() {
 #[test]
 fn bvh_single_primitive_is_one_leaf() {
     let mesh = soup(1, 7);
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let bvh = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     bvh.validate(&mesh).unwrap();
     assert_eq!(bvh.nodes().len(), 1);
     assert!(bvh.nodes()[0].is_leaf());
@@ -80,7 +80,7 @@ fn bvh_matches_brute_force_on_small_soup() {
 fn bvh_duplicates_at_one_point_keep_leaves_bounded() {
     let mut mesh = soup(1, 1);
     mesh.indices = vec![[0, 1, 2]; 1000];
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let bvh = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     bvh.validate(&mesh).unwrap();
     assert!(bvh.nodes().iter().all(|n| (n.count as usize) <= LEAF_HARD_MAX));
     // Every copy is hit at the same t; the lowest index wins.
@@ -116,7 +116,7 @@ fn bvh_non_finite_primitives_stay_out_of_the_tree() {
     mesh.indices.push([nan, nan + 1, nan + 2]);
     mesh.indices.push([nan + 1, nan + 2, 0]);
     mesh.indices.push([0, nan + 1, 1]);
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let bvh = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     bvh.validate(&mesh).unwrap();
     let root = bvh.nodes()[0].bounds();
     assert!(root.min.is_finite() && root.max.is_finite());
@@ -172,7 +172,7 @@ fn bvh_build_is_identical_for_any_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| Bvh::build_sah(&mesh, &BvhParams::default()))
+            .install(|| Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep))
     };
     let (one, four) = (on(1), on(4));
     assert_eq!(one.nodes(), four.nodes());
@@ -200,7 +200,7 @@ fn bvh_nan_and_zero_rays_hit_nothing() {
 #[test]
 fn bvh_stats_describe_the_tree() {
     let mesh = soup(10_000, 6);
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let bvh = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     let s = Accel::<TriangleMesh>::stats(&bvh);
     assert_eq!(s.kind, "bvh-sah");
     assert_eq!(s.primitives, 10_000);
@@ -210,6 +210,69 @@ fn bvh_stats_describe_the_tree() {
     // Binary nodes and indices, the 8-wide nodes, and the blocks of four triangles.
     let wide = 256 * bvh.wide.nodes().len() + 160 * bvh.wide.blocks().len();
     assert_eq!(s.bytes, std::mem::size_of::<Bvh>() + 32 * s.nodes + 4 * 10_000 + wide);
+}
+
+#[test]
+fn mesh_bvh_drops_its_binary_tree_and_indices_and_nothing_else_changes() {
+    let mesh = soup(10_000, 6);
+    let opaque = Opaque(&mesh);
+    let rays = rays(2000, 8);
+    for (kept, dropped) in [
+        (Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep), Bvh::build_sah(&mesh, &BvhParams::default())),
+        (
+            Bvh::median(&mesh, &MedianParams::default(), Binary::Keep),
+            Bvh::build_median(&mesh, &MedianParams::default()),
+        ),
+        (
+            Bvh::bottom_up(&mesh, &BottomUpParams::default(), Binary::Keep),
+            Bvh::build_bottom_up(&mesh, &BottomUpParams::default()),
+        ),
+    ] {
+        assert!(!kept.binary_dropped() && dropped.binary_dropped());
+        assert!(dropped.nodes().is_empty() && dropped.prim_indices().is_empty());
+        let (k, d) = (Accel::<TriangleMesh>::stats(&kept), Accel::<TriangleMesh>::stats(&dropped));
+        let freed = std::mem::size_of_val(kept.nodes()) + std::mem::size_of_val(kept.prim_indices());
+        assert_eq!(d.bytes, k.bytes - freed, "{}", k.kind);
+        assert_eq!(
+            AccelStats { bytes: 0, build_time: Duration::ZERO, ..d },
+            AccelStats { bytes: 0, build_time: Duration::ZERO, ..k }
+        );
+        assert_eq!(Accel::<TriangleMesh>::bounds(&dropped), Accel::<TriangleMesh>::bounds(&kept));
+        dropped.validate(&mesh).unwrap();
+        for ray in &rays {
+            assert_eq!(bits(dropped.intersect(&mesh, ray, 30.0)), bits(kept.intersect(&mesh, ray, 30.0)));
+            assert_eq!(dropped.occluded(&mesh, ray, 4.0), kept.occluded(&mesh, ray, 4.0));
+        }
+        let mut out = vec![None; rays.len()];
+        dropped.intersect_many(&mesh, &rays, &vec![30.0; rays.len()], &mut out);
+        let each: Vec<_> = rays.iter().map(|r| kept.intersect(&mesh, r, 30.0)).collect();
+        assert_eq!(out.into_iter().map(bits).collect::<Vec<_>>(), each.into_iter().map(bits).collect::<Vec<_>>());
+        // The boxes view shows the wide tree: the root's box, then the lanes below it.
+        let root = Accel::<TriangleMesh>::boxes_at_depth(&dropped, 0);
+        assert_eq!(root, Accel::<TriangleMesh>::boxes_at_depth(&kept, 0));
+        let level = Accel::<TriangleMesh>::boxes_at_depth(&dropped, 1);
+        assert!((2..=8).contains(&level.len()) && level.iter().all(|b| root[0].contains(b)), "{level:?}");
+    }
+    // Other primitives keep the index array their leaves read.
+    let generic = Bvh::build_sah(&opaque, &BvhParams::default());
+    assert!(!generic.binary_dropped() && generic.prim_indices().len() == 10_000);
+}
+
+#[test]
+fn validate_checks_the_wide_tree_of_a_mesh_bvh_without_its_binary_tree() {
+    let mesh = soup(2000, 9);
+    let good = Bvh::build_sah(&mesh, &BvhParams::default());
+    good.validate(&mesh).unwrap();
+    assert!(good.validate(&soup(1999, 9)).is_err());
+    let mut swapped = good.clone();
+    let blocks = swapped.wide.blocks_mut();
+    let (a, b) = (blocks[0].prim[0], blocks[blocks.len() - 1].prim[0]);
+    blocks[0].prim[0] = b;
+    blocks.last_mut().unwrap().prim[0] = a;
+    assert!(swapped.validate(&mesh).is_err(), "primitives swapped between far apart leaves");
+    let mut moved = good.clone();
+    moved.wide.blocks_mut()[0].tris.v[0][0][0] += 1.0;
+    assert!(moved.validate(&mesh).is_err(), "a corner that is not the mesh's");
 }
 
 #[test]
@@ -260,7 +323,7 @@ fn median_matches_brute_force_on_small_soup() {
 #[test]
 fn median_tree_is_balanced_with_bounded_leaves() {
     let mesh = soup(10_000, 41);
-    let bvh = Bvh::build_median(&mesh, &MedianParams { max_leaf_prims: 5 });
+    let bvh = Bvh::median(&mesh, &MedianParams { max_leaf_prims: 5 }, Binary::Keep);
     let s = Accel::<TriangleMesh>::stats(&bvh);
     assert_eq!(s.kind, "bvh-median");
     // 10,000 halved until at most 5: every leaf at depth 11 (10,000 / 2^11 is 4.9), 3 to 5 primitives.
@@ -282,7 +345,7 @@ fn median_splits_coincident_centroids_by_index() {
 #[test]
 fn median_build_is_identical_for_any_thread_count() {
     let mesh = soup(20_000, 42);
-    let build = || Bvh::build_median(&mesh, &MedianParams::default());
+    let build = || Bvh::median(&mesh, &MedianParams::default(), Binary::Keep);
     let (one, four) = (on_threads(1, build), on_threads(4, build));
     assert_eq!(one.nodes(), four.nodes());
     assert_eq!(one.prim_indices(), four.prim_indices());
@@ -323,7 +386,7 @@ impl Primitives for Opaque<'_> {
 fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() {
     let mesh = soup(3000, 17);
     let opaque = Opaque(&mesh);
-    let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+    let with_copy = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     let without = Bvh::build_sah(&opaque, &BvhParams::default());
     assert!(with_copy.wide.bytes() > without.wide.bytes(), "a mesh gets its triangles copied in leaf order");
     for ray in rays(2000, 5) {
@@ -432,7 +495,7 @@ fn bvh_batch_of_mismatched_lengths_panics() {
 #[test]
 fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_free_lanes() {
     let mesh = soup(3000, 41);
-    let bvh = Bvh::build_sah(&mesh, &BvhParams::default());
+    let bvh = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
     let (nodes, blocks) = (bvh.wide.nodes(), bvh.wide.blocks());
     let mut seen = vec![0u32; mesh.len()];
     let mut leaf_lanes = 0;
@@ -501,7 +564,7 @@ mod scalar_path {
         let mesh = soup(TRIS, 61);
         let opaque = Opaque(&mesh);
         let brute = BruteForce::build(&mesh);
-        let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
+        let with_copy = Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep);
         let without = Bvh::build_sah(&opaque, &BvhParams::default());
         assert!(with_copy.wide.nodes().len() > 1, "a tree of more than one wide node");
         let rays = aimed_rays(&mesh, RAYS, 13);

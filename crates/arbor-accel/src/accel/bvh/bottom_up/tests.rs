@@ -4,7 +4,7 @@
 use super::*;
 use crate::accel::bvh::build::BuildPrim;
 use crate::accel::bvh::tests::{assert_matches_brute, on_threads, rays, sah, soup};
-use crate::accel::bvh::{Bvh, BvhParams, MAX_DEPTH, MAX_SAH_DEPTH};
+use crate::accel::bvh::{Binary, Bvh, BvhParams, MAX_DEPTH, MAX_SAH_DEPTH};
 use crate::accel::{Accel, AccelConfig, AccelKind};
 use crate::geometry::TriangleMesh;
 use crate::math::{Ray, Vec3};
@@ -79,11 +79,11 @@ fn bottom_up_handles_empty_single_and_duplicate_sets() {
     for method in [BottomUpMethod::Greedy, BottomUpMethod::Ploc] {
         let params = with(method, MergeCost::Area, 8);
         let empty = TriangleMesh::default();
-        let bvh = Bvh::build_bottom_up(&empty, &params);
+        let bvh = Bvh::bottom_up(&empty, &params, Binary::Keep);
         bvh.validate(&empty).unwrap();
         assert!(bvh.nodes().is_empty());
         let one = soup(1, 3);
-        assert_eq!(Bvh::build_bottom_up(&one, &params).nodes().len(), 1);
+        assert_eq!(Bvh::bottom_up(&one, &params, Binary::Keep).nodes().len(), 1);
         let mut dup = soup(1, 1);
         dup.indices = vec![[0, 1, 2]; 1000];
         let bvh = Bvh::build_bottom_up(&dup, &params);
@@ -109,7 +109,7 @@ fn bottom_up_sah_cost_is_within_a_sane_factor_of_binned_sah_on_soups() {
 fn bottom_up_build_is_identical_for_any_thread_count() {
     for (n, method) in [(1500, BottomUpMethod::Greedy), (20_000, BottomUpMethod::Ploc)] {
         let mesh = soup(n, 60);
-        let build = || Bvh::build_bottom_up(&mesh, &with(method, MergeCost::Area, 8));
+        let build = || Bvh::bottom_up(&mesh, &with(method, MergeCost::Area, 8), Binary::Keep);
         let (one, four) = (on_threads(1, build), on_threads(4, build));
         assert_eq!(one.nodes(), four.nodes(), "{method:?}");
         assert_eq!(one.prim_indices(), four.prim_indices(), "{method:?}");

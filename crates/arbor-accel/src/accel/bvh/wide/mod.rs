@@ -31,6 +31,7 @@
 
 mod any_hit;
 mod batch;
+mod check;
 mod closest;
 mod dispatch;
 mod kernel;
