@@ -2,37 +2,43 @@
 """Render-level speed of two Arbor binaries on the same scenes: Mrays/s and the traversal share.
 
 Each round renders every scene with each binary in turn (A, B, A, B...), so that drifts of a shared
-machine's load hit both alike, and the table gives the median over rounds of `render X ms`, the rays,
-Mrays/s and, when the binary prints it, the share of thread time in the structure's queries. Images go
-to a temporary folder; a scene may name one camera (`scene.xml:ID`) and extra `arbor render` flags are
-passed with `--flags`.
+machine's load hit both alike, and the table gives the median over rounds of the render time, the rays,
+Mrays/s and, when the binary reports it, the share of thread time in the structure's queries (all read
+from `arbor render --stats-json`). Images go to a temporary folder; a scene may name one camera
+(`scene.xml:ID`) and extra `arbor render` flags are passed with `--flags`.
 
     scripts/render-speed.py --before /tmp/arbor-old --after target/release/arbor --rounds 3 --threads 1 \\
         ../shared/scenes/ceng795-2024-hw1/hw1/inputs/cornellbox_recursive.xml ...
 """
 
 import argparse
+import json
 import os
-import re
 import statistics
 import subprocess
 import sys
 import tempfile
 
-SUMMARY = re.compile(r"render ([\d.]+) ms\s+([\d.]+) M rays\s+([\d.]+) Mrays/s(?:\s+traversal (\d+)%)?")
-
 
 def run(binary, scene, threads, flags, out):
+    """(render ms, M rays, Mrays/s, traversal %) of one render, from `arbor render --stats-json`, summed
+    over the scene's images (traversal weighted by render time; None when the binary does not report it)."""
     path, _, camera = scene.partition(":")
-    cmd = [binary, "render", path, "--threads", str(threads), "-o", out, "--no-warnings"] + flags
+    stats = os.path.join(out, "stats.json")
+    cmd = [binary, "render", path, "--threads", str(threads), "-o", out, "--no-warnings", "-q",
+           "--stats-json", stats] + flags
     if camera:
         cmd += ["--camera", camera]
     done = subprocess.run(cmd, capture_output=True, text=True)
-    found = SUMMARY.search(done.stdout)
-    if done.returncode != 0 or not found:
+    if done.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{done.stderr.strip()}")
-    ms, rays, mrays, share = found.groups()
-    return float(ms), float(rays), float(mrays), None if share is None else int(share)
+    with open(stats) as f:
+        images = json.load(f)["images"]
+    ms = sum(i["render_ms"] for i in images)
+    rays = sum(i["rays"] for i in images)
+    shares = [i.get("traversal_share") for i in images]
+    share = None if None in shares else 100 * sum(s * i["render_ms"] for s, i in zip(shares, images)) / ms
+    return ms, rays / 1e6, rays / 1e3 / ms, share
 
 
 def main():
