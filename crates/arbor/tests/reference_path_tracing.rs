@@ -165,7 +165,13 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, full: bool) -> Vec<S
     failures
 }
 
-fn check(failures: Vec<String>) {
+/// Runs every set ([`run`]'s `full`) and fails with every camera that fails.
+fn run_sets(full: bool) {
+    let Some(dir) = common::scenes_dir() else { return };
+    let mut failures = Vec::new();
+    for (title, (cases, skipped)) in sets(&dir) {
+        failures.extend(run(title, cases, skipped, full));
+    }
     assert!(failures.is_empty(), "{} failed:\n{}", failures.len(), failures.join("\n"));
 }
 
@@ -187,21 +193,11 @@ fn sets(dir: &Path) -> Vec<Set> {
             Russian roulette references are brighter than the unbiased answer and the plain cameras fail \
             in display space (see docs/reference-results.md)"]
 fn reference_path_tracing() {
-    let Some(dir) = common::scenes_dir() else { return };
-    let mut failures = Vec::new();
-    for (title, (cases, skipped)) in sets(&dir) {
-        failures.extend(run(title, cases, skipped, false));
-    }
-    check(failures);
+    run_sets(false);
 }
 
 #[test]
 #[ignore = "every camera at its own samples over the whole frame: hours on two cores"]
 fn reference_path_tracing_full() {
-    let Some(dir) = common::scenes_dir() else { return };
-    let mut failures = Vec::new();
-    for (title, (cases, skipped)) in sets(&dir) {
-        failures.extend(run(title, cases, skipped, true));
-    }
-    check(failures);
+    run_sets(true);
 }
