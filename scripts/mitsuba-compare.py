@@ -8,7 +8,7 @@ untimed first, to compile), and with `arbor render --integrator path --path-opti
 estimator as Mitsuba's: cosine-sampled bounces and light samples weighted by MIS; --arbor-path-options
 picks another, '' the scene's RendererParams), at the same samples per pixel
 on each thread count. For every render it prints samples per second (width x height x spp / seconds
-of rendering, scene loading excluded; Arbor's from the `render X ms` of its summary line), the RMSE in
+of rendering, scene loading excluded; Arbor's `render_ms` of its `--stats-json`), the RMSE in
 linear radiance against a high-spp render of each renderer (cached in --cache, rendered with another
 seed) and the 1-minute load average (the machine may be shared), then a Markdown table for
 docs/performance.md. When the scene's `../outputs/` folder holds the official image its camera names,
@@ -34,9 +34,9 @@ non-uniformly scaled spheres, a lens) is refused with its reason and the scene s
 """
 
 import argparse
+import json
 import math
 import os
-import re
 import subprocess
 import sys
 import tempfile
@@ -288,20 +288,21 @@ ARBOR_UNIT = 255.0
 
 
 def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0):
-    """(image, seconds from Arbor's `render X ms` summary), or None with the reason printed."""
+    """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed."""
+    stats = Path(str(out) + ".stats.json")
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
-           "--seed", str(seed), "-o", str(out), "--no-warnings"]
+           "--seed", str(seed), "-o", str(out), "--no-warnings", "--stats-json", str(stats)]
     if integrator:
         cmd += ["--integrator", integrator]
     if integrator and path_options:
         cmd += ["--path-options", path_options]
     run = subprocess.run(cmd, capture_output=True, text=True)
-    found = re.search(r"render ([0-9.]+) ms", run.stdout + run.stderr)
-    if run.returncode != 0 or not found:
+    if run.returncode != 0 or not stats.is_file():
         print(f"  Arbor failed (exit {run.returncode}): {' '.join(cmd)}\n    " +
               (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
         return None
-    return read_exr(out) * ARBOR_UNIT, float(found.group(1)) / 1e3
+    render_ms = json.loads(stats.read_text())["images"][0]["render_ms"]
+    return read_exr(out) * ARBOR_UNIT, render_ms / 1e3
 
 
 def read_exr(path):
