@@ -142,6 +142,19 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
         assert!(["avx2", "sse", "scalar"].contains(&kernel), "{line}");
     }
 
+    // --query any times the any-hit query: blocked or not, judged against whether the reference hit.
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--query", "any", "--runs", "1"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("peer=")).collect();
+    assert_eq!(lines.len(), 4, "{out}");
+    for (line, mode) in lines.iter().zip(["-any", "-any-batch", "-any", "-any-batch"]) {
+        assert!(line.starts_with(&format!("peer=arbor-bvh-sah{mode} ")), "{line}");
+        assert!(line.contains(" hits=2 ") && line.contains("mismatch=0.333333"), "{line}");
+    }
+    let o = arbor(&["bench", "quad.off", "--query", "any"], tmp.path());
+    assert_eq!(o.status.code(), Some(2), "--query needs --ray-dir: {}", stderr(&o));
+
     // --rays picks the sets of the folder: the primary files are not even read.
     std::fs::write(dir.join("primary.rays"), b"").unwrap();
     let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--rays", "diffuse", "--runs", "1"], tmp.path());

@@ -110,15 +110,16 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> Ca
             assert_eq!(got, occluded, "{kind} on {case}: occluded {:?} t_max {}", p.ray, p.t_max);
         }
         if !is_reference {
-            check_batches(case, kind, accel.as_ref(), prims, probes, &single);
+            check_batches(case, kind, accel.as_ref(), prims, probes, &single, &expected);
         }
     }
     Cast { rays: probes.len(), hits: expected.iter().filter(|(hit, _)| hit.is_some()).count() }
 }
 
-/// `intersect_many` gives each probe the very hit its own query gave (`single`), in batches of 1, 2, 3,
-/// 5, 8, 13 and 64 probes in turn (odd sizes leave a slot of the interleaved BVH idle, long ones refill
-/// its slots many times).
+/// `intersect_many` gives each probe the very hit its own query gave (`single`), and `occluded_many`
+/// brute force's answer (`expected`), also at exactly each hit's `t` (false) and the float above
+/// (true); in batches of 1, 2, 3, 5, 8, 13 and 64 probes in turn (odd sizes leave a slot of the
+/// interleaved BVH idle, long ones refill its slots many times).
 fn check_batches<P: Primitives>(
     case: &str,
     kind: AccelKind,
@@ -126,15 +127,36 @@ fn check_batches<P: Primitives>(
     prims: &P,
     probes: &[Probe],
     single: &[Option<Hit>],
+    expected: &[(Option<Hit>, bool)],
 ) {
     let rays: Vec<Ray> = probes.iter().map(|p| p.ray).collect();
     let t_max: Vec<f32> = probes.iter().map(|p| p.t_max).collect();
     let mut batched = vec![None; probes.len()];
+    let mut blocked = vec![false; probes.len()];
+    let hit_t: Vec<f32> = expected.iter().zip(&t_max).map(|((h, _), &t)| h.map_or(t, |h| h.t)).collect();
+    let above: Vec<f32> = expected.iter().zip(&t_max).map(|((h, _), &t)| h.map_or(t, |h| h.t.next_up())).collect();
+    let (mut at, mut past) = (vec![false; probes.len()], vec![false; probes.len()]);
     let (mut start, mut k) = (0, 0);
     while start < probes.len() {
         let end = (start + [1, 2, 3, 5, 8, 13, 64][k % 7]).min(probes.len());
-        accel.intersect_many(prims, &rays[start..end], &t_max[start..end], &mut batched[start..end]);
+        let r = start..end;
+        accel.intersect_many(prims, &rays[r.clone()], &t_max[r.clone()], &mut batched[r.clone()]);
+        accel.occluded_many(prims, &rays[r.clone()], &t_max[r.clone()], &mut blocked[r.clone()]);
+        accel.occluded_many(prims, &rays[r.clone()], &hit_t[r.clone()], &mut at[r.clone()]);
+        accel.occluded_many(prims, &rays[r.clone()], &above[r.clone()], &mut past[r]);
         (start, k) = (end, k + 1);
+    }
+    for (i, (p, &(hit, occluded))) in probes.iter().zip(expected).enumerate() {
+        assert_eq!(blocked[i], occluded, "{kind} on {case}: batch occluded of probe {i} {:?} t_max {}", p.ray, p.t_max);
+        if hit.is_some() {
+            assert_eq!(
+                (at[i], past[i]),
+                (false, true),
+                "{kind} on {case}: batch occluded of probe {i} just at and above the hit t {} {:?}",
+                hit_t[i],
+                p.ray
+            );
+        }
     }
     for (i, p) in probes.iter().enumerate() {
         assert!(

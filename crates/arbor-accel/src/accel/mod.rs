@@ -264,6 +264,21 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
             *o = self.intersect(prims, r, t);
         }
     }
+    /// [`Accel::occluded`] for a batch: `out[i]` becomes whether `rays[i]` hits anything in
+    /// `(0, t_max[i])`. A structure may trace several rays at once (the BVH interleaves two); the default
+    /// asks one query per ray.
+    ///
+    /// # Panics
+    /// When `rays`, `t_max` and `out` differ in length.
+    fn occluded_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
+        assert!(
+            rays.len() == t_max.len() && rays.len() == out.len(),
+            "a batch's rays, t_max and answers differ in length"
+        );
+        for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
+            *o = self.occluded(prims, r, t);
+        }
+    }
 }
 
 /// The structures Arbor can build.

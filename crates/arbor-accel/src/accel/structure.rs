@@ -92,7 +92,7 @@ impl<P: Primitives + ?Sized + Send + 'static> Structure<P> {
     }
 
     /// [`Structure::occluded`] for a batch: `out[i]` becomes whether `rays[i]` hits anything in
-    /// `(0, t_max[i])`.
+    /// `(0, t_max[i])`, the same answer as a query of its own (the BVH traces two rays at once).
     ///
     /// ```
     /// use arbor_accel::accel::{AccelConfig, Structure};
@@ -114,13 +114,7 @@ impl<P: Primitives + ?Sized + Send + 'static> Structure<P> {
     /// # Panics
     /// When `rays`, `t_max` and `out` differ in length.
     pub fn occluded_many(&self, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
-        assert!(
-            rays.len() == t_max.len() && rays.len() == out.len(),
-            "a batch's rays, t_max and answers differ in length"
-        );
-        for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
-            *o = self.occluded(r, t);
-        }
+        self.accel.occluded_many(&self.prims, rays, t_max, out);
     }
 
     /// Statistics of the built structure (nodes, leaves, depth, SAH cost, bytes, build time).

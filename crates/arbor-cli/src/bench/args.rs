@@ -28,6 +28,10 @@ pub struct BenchArgs {
     /// exactly the peers' rays and print peerbench's line format (see docs/performance.md).
     #[arg(long, value_name = "DIR", conflicts_with_all = ["size", "brute_rays", "json", "no_limits"])]
     pub ray_dir: Option<PathBuf>,
+    /// With --ray-dir: which query to time on the peers' rays: closest hits, or any hits (shadow-ray
+    /// queries up to each ray's t_max; `peer=arbor-KIND-any`, judged by whether the reference hit).
+    #[arg(long, value_enum, default_value_t = Query::Closest, requires = "ray_dir")]
+    pub query: Query,
     /// Image size WxH, overriding the camera's resolution (the window stays: same view, fewer rays).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -45,6 +49,15 @@ pub struct BenchArgs {
     /// Lift the limits on image size and recursion depth (as `arbor render --no-limits`).
     #[arg(long)]
     pub no_limits: bool,
+}
+
+/// The query `--query` names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Query {
+    /// `intersect` and `intersect_many`.
+    Closest,
+    /// `occluded` and `occluded_many`.
+    Any,
 }
 
 /// The ray sets `--rays` names.

@@ -10,6 +10,9 @@
 //! Every structure is traced twice: one query per ray (`peer=arbor-KIND`, as peerbench calls Embree's
 //! `rtcIntersect1`), and whole batches through [`Accel::intersect_many`] (`peer=arbor-KIND-batch`, the
 //! BVH interleaving two rays; the renderer traces its camera rays so).
+//! With `--query any`, the same two forms of the any-hit query (`occluded`, `occluded_many`) run
+//! instead, as `peer=arbor-KIND-any` and `-any-batch`; their `mismatch` counts rays whose answer
+//! differs from whether the reference peer hit anything.
 //! `mismatch` is the share of rays whose hit disagrees with the reference peer's (hit or miss, or `t`
 //! off by more than 1e-4 relative, see [`disagrees`]).
 //!
@@ -27,7 +30,7 @@ use arbor::geometry::TriangleMesh;
 use arbor::math::Ray;
 use rayon::prelude::*;
 
-use super::args::{specs, BenchArgs};
+use super::args::{specs, BenchArgs, Query};
 use crate::Failure;
 
 /// Rays per parallel work item (peerbench's chunk size).
@@ -95,7 +98,11 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), Failure> {
         let list: Vec<String> = builds.iter().map(|b| format!("{b:.1}")).collect();
         say!("# peer=arbor-{} built in {} ms", spec.kind(), list.join(", "));
         for (set, batch) in sets.iter().zip(&batches) {
-            for mode in [Mode::Single, Mode::Batch] {
+            let modes = match args.query {
+                Query::Closest => [Mode::Single, Mode::Batch],
+                Query::Any => [Mode::AnySingle, Mode::AnyBatch],
+            };
+            for mode in modes {
                 let r = measure(accel.as_ref(), &mesh, set, batch, threads, mode);
                 say!(
                     "peer=arbor-{}{} set={} threads={threads} build_ms={build_ms:.2} mrays={:.3} hits={} mesh={} \
@@ -134,6 +141,10 @@ enum Mode {
     Single,
     /// [`Accel::intersect_many`] over the whole set (one thread) or each chunk.
     Batch,
+    /// One [`Accel::occluded`] per ray.
+    AnySingle,
+    /// [`Accel::occluded_many`] over the whole set (one thread) or each chunk.
+    AnyBatch,
 }
 
 impl Mode {
@@ -141,6 +152,8 @@ impl Mode {
         match self {
             Mode::Single => "",
             Mode::Batch => "-batch",
+            Mode::AnySingle => "-any",
+            Mode::AnyBatch => "-any-batch",
         }
     }
 }
@@ -160,12 +173,13 @@ fn measure(
     mode: Mode,
 ) -> Measured {
     let mut hits = vec![None; set.rays.len()];
+    let mut blocked = vec![false; set.rays.len()];
     let mut times = Vec::new();
     let mut cpu_times = Vec::new();
     let mut total = Duration::ZERO;
     while times.len() < MIN_RUNS || total < MIN_TIME {
         let (start, cpu) = (Instant::now(), cpu_time());
-        trace_all(accel, mesh, batch, threads, mode, &mut hits);
+        trace_all(accel, mesh, batch, threads, mode, &mut hits, &mut blocked);
         let dt = start.elapsed();
         total += dt;
         times.push(dt.as_secs_f64());
@@ -175,17 +189,27 @@ fn measure(
         }
     }
     let secs = median(&mut times).max(1e-9);
-    let wrong = hits.iter().zip(&set.hits).filter(|(h, r)| disagrees(h.map(|h| h.t), r)).count();
+    let (wrong, hit) = match mode {
+        Mode::Single | Mode::Batch => (
+            hits.iter().zip(&set.hits).filter(|(h, r)| disagrees(h.map(|h| h.t), r)).count(),
+            hits.iter().flatten().count(),
+        ),
+        Mode::AnySingle | Mode::AnyBatch => (
+            blocked.iter().zip(&set.hits).filter(|(&b, r)| b != r.is_hit()).count(),
+            blocked.iter().filter(|&&b| b).count(),
+        ),
+    };
     Measured {
         mrays: set.rays.len() as f64 / secs / 1e6,
         cpu_mrays: set.rays.len() as f64 / median(&mut cpu_times).max(1e-9) / 1e6,
-        hits: hits.iter().flatten().count(),
+        hits: hit,
         runs: times.len(),
         mismatch: wrong as f64 / set.rays.len().max(1) as f64,
     }
 }
 
-/// Closest hits of the batch into `out`: on this thread for one thread, else in chunks on rayon.
+/// The batch's closest hits into `out` or any-hit answers into `blocked`, as `mode` asks: on this
+/// thread for one thread, else in chunks on rayon.
 fn trace_all(
     accel: &dyn Accel<TriangleMesh>,
     mesh: &TriangleMesh,
@@ -193,22 +217,30 @@ fn trace_all(
     threads: usize,
     mode: Mode,
     out: &mut [Option<Hit>],
+    blocked: &mut [bool],
 ) {
-    let trace = |rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]| match mode {
+    let trace = |rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>], blocked: &mut [bool]| match mode {
         Mode::Single => {
             for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
                 *o = accel.intersect(mesh, r, t);
             }
         }
         Mode::Batch => accel.intersect_many(mesh, rays, t_max, out),
+        Mode::AnySingle => {
+            for ((b, r), &t) in blocked.iter_mut().zip(rays).zip(t_max) {
+                *b = accel.occluded(mesh, r, t);
+            }
+        }
+        Mode::AnyBatch => accel.occluded_many(mesh, rays, t_max, blocked),
     };
     if threads == 1 {
-        trace(&batch.rays, &batch.t_max, out);
+        trace(&batch.rays, &batch.t_max, out, blocked);
     } else {
         out.par_chunks_mut(CHUNK)
+            .zip(blocked.par_chunks_mut(CHUNK))
             .zip(batch.rays.par_chunks(CHUNK))
             .zip(batch.t_max.par_chunks(CHUNK))
-            .for_each(|((o, r), t)| trace(r, t, o));
+            .for_each(|(((o, b), r), t)| trace(r, t, o, b));
     }
 }
 

@@ -318,6 +318,10 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
         wide::occluded(&self.wide, &self.prim_indices, prims, ray, t_max)
     }
 
+    fn occluded_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
+        wide::occluded_many(&self.wide, &self.prim_indices, prims, rays, t_max, out)
+    }
+
     fn stats(&self) -> AccelStats {
         self.compute_stats(self.kind, self.build_time)
     }

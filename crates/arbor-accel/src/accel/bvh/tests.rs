@@ -440,7 +440,7 @@ fn bvh_wide_kernels_visit_the_same_nodes_and_return_the_same_hits() {
 
 #[test]
 fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind() {
-    use super::wide::intersect_many_with;
+    use super::wide::{intersect_many_with, occluded_many_with};
     let mesh = soup(4000, 41);
     let opaque = Opaque(&mesh);
     let with_copy = Bvh::build_sah(&mesh, &BvhParams::default());
@@ -462,6 +462,8 @@ fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind
     let (rays, t_max): (Vec<Ray>, Vec<f32>) = batch.iter().copied().unzip();
     let single: Vec<Option<Hit>> = batch.iter().map(|(r, t)| with_copy.intersect(&mesh, r, *t)).collect();
     assert!(single.iter().filter(|h| h.is_some()).count() > 300, "the rays must hit");
+    let blocked: Vec<bool> = batch.iter().map(|(r, t)| with_copy.occluded(&mesh, r, *t)).collect();
+    assert!(blocked.iter().filter(|&&b| !b).count() > 300, "some rays must get through");
     for &k in &kernels {
         // Every batch size up to 5 (one or both slots, refilled or not), then the rest at once.
         for n in (0..=5).chain([rays.len()]) {
@@ -471,17 +473,29 @@ fn bvh_batches_give_every_ray_its_own_querys_hit_with_every_kernel_and_leaf_kind
             let mut out = vec![None; n];
             intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut out);
             assert_eq!(out, single[..n], "{k:?} primitive leaves, batch of {n}");
+            let mut any = vec![true; n];
+            occluded_many_with(k, &with_copy.wide, &with_copy.prim_indices, &mesh, &rays[..n], &t_max[..n], &mut any);
+            assert_eq!(any, blocked[..n], "{k:?} mesh leaves, any-hit batch of {n}");
+            let mut any = vec![true; n];
+            occluded_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays[..n], &t_max[..n], &mut any);
+            assert_eq!(any, blocked[..n], "{k:?} primitive leaves, any-hit batch of {n}");
         }
     }
     // Through the trait, and on an empty tree.
     let mut out = vec![None; rays.len()];
     with_copy.intersect_many(&mesh, &rays, &t_max, &mut out);
     assert_eq!(out, single);
+    let mut any = vec![true; rays.len()];
+    with_copy.occluded_many(&mesh, &rays, &t_max, &mut any);
+    assert_eq!(any, blocked);
     let empty = TriangleMesh::default();
     let bvh = Bvh::build_sah(&empty, &BvhParams::default());
     let mut out = vec![Some(Hit::new(0, PrimHit::new(1.0, 0.0, 0.0))); 3];
     bvh.intersect_many(&empty, &rays[..3], &t_max[..3], &mut out);
     assert_eq!(out, [None, None, None]);
+    let mut any = [true; 3];
+    bvh.occluded_many(&empty, &rays[..3], &t_max[..3], &mut any);
+    assert_eq!(any, [false; 3]);
 }
 
 #[test]
@@ -532,7 +546,7 @@ fn bvh_wide_leaf_blocks_hold_every_triangle_once_inside_their_lane_box_and_use_f
 /// `Kernel::detect` gives the scalar kernel; natively, the tests above compare all kernels.
 mod scalar_path {
     use super::*;
-    use crate::accel::bvh::wide::{intersect_many_with, intersect_with, occluded_with, Kernel};
+    use crate::accel::bvh::wide::{intersect_many_with, intersect_with, occluded_many_with, occluded_with, Kernel};
 
     /// Enough triangles for a wide tree of two levels (leaves of up to 8, 8 children per node).
     const TRIS: usize = if cfg!(miri) { 150 } else { 1500 };
@@ -601,6 +615,12 @@ mod scalar_path {
                 let (w, i) = (&without.wide, &without.prim_indices);
                 intersect_many_with(kernel, w, i, &opaque, &rays[..n], &t_max[..n], &mut out);
                 assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want[..n], "{kernel:?} batch of {n}");
+                let mut any = vec![false; n];
+                occluded_many_with(kernel, w, i, &opaque, &rays[..n], &t_max[..n], &mut any);
+                assert_eq!(any, occluded[..n], "{kernel:?} primitive leaves, any-hit batch of {n}");
+                let (w, i) = (&with_copy.wide, &with_copy.prim_indices);
+                occluded_many_with(kernel, w, i, &mesh, &rays[..n], &t_max[..n], &mut any);
+                assert_eq!(any, occluded[..n], "{kernel:?} mesh leaves, any-hit batch of {n}");
             }
         }
     }

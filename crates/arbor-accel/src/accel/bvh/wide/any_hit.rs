@@ -1,8 +1,11 @@
 //! The any-hit query (shadow rays) on the 8-wide tree: stops at the first hit, visits children in any
-//! order, so it needs neither entry distances on its stack nor the closest-hit bookkeeping.
+//! order, so it needs neither entry distances on its stack nor the closest-hit bookkeeping. A batch
+//! ([`occluded_many`]) walks two rays at once as the closest-hit batch does (`batch.rs`), with the
+//! same node visit ([`visit_any`]) and so the same nodes and answer per ray as the single query.
 
 use std::mem::MaybeUninit;
 
+use super::batch::{many, Walker};
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
 use super::leaves::{LeafRay, Leaves};
@@ -37,6 +40,33 @@ pub(in crate::accel::bvh) fn occluded_with<P: Primitives + ?Sized>(
     run_with(kernel, wide, indices, prims, AnyHit { ray, t_max })
 }
 
+/// Any-hit queries for a batch of rays, `out[i]` for `rays[i]` in `(0, t_max[i])`: the same answers as
+/// [`occluded`] ray by ray.
+pub(in crate::accel::bvh) fn occluded_many<P: Primitives + ?Sized>(
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [bool],
+) {
+    occluded_many_with(Kernel::detect(), wide, indices, prims, rays, t_max, out)
+}
+
+/// [`occluded_many`] with the given kernel (tests compare the kernels).
+pub(in crate::accel::bvh) fn occluded_many_with<P: Primitives + ?Sized>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [bool],
+) {
+    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and answers differ in length");
+    run_with(kernel, wide, indices, prims, AnyBatch { rays, t_max, out })
+}
+
 /// The any-hit query of one ray.
 struct AnyHit<'a> {
     ray: &'a Ray,
@@ -56,6 +86,55 @@ impl Traversal for AnyHit<'_> {
     }
 }
 
+/// The any-hit queries of a batch.
+struct AnyBatch<'a> {
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    out: &'a mut [bool],
+}
+
+impl Traversal for AnyBatch<'_> {
+    type Out = ();
+
+    fn empty(self) {
+        self.out.fill(false);
+    }
+
+    #[inline(always)]
+    fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) {
+        many::<AnyWalk, L, K>(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
+    }
+}
+
+/// The any-hit stack: children still to visit, in no order.
+type AnyStack = [MaybeUninit<Ref>; STACK];
+
+/// One node visit: tests `node`'s eight boxes against `[0, t_max]`, pushes every child hit but the
+/// first and returns the first; `None` when no box is hit.
+#[inline(always)]
+fn visit_any<K: NodeTest>(
+    kernel: K,
+    lanes: &Lanes,
+    node: &Node8,
+    t_max: f32,
+    stack: &mut AnyStack,
+    sp: &mut usize,
+) -> Option<Ref> {
+    let (mut mask, _, _) = kernel.test(lanes, node, t_max);
+    if mask == 0 {
+        return None;
+    }
+    let first = mask.trailing_zeros() as usize;
+    mask &= mask - 1;
+    while mask != 0 {
+        let l = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        stack[*sp] = MaybeUninit::new(Ref { child: node.child[l], count: node.count[l] });
+        *sp += 1;
+    }
+    Some(Ref { child: node.child[first], count: node.count[first] })
+}
+
 /// The any-hit traversal from `root`.
 #[inline(always)]
 fn any_hit<L: Leaves, K: NodeTest>(kernel: K, nodes: &[Node8], leaves: &L, root: Ref, ray: &Ray, t_max: f32) -> bool {
@@ -67,17 +146,8 @@ fn any_hit<L: Leaves, K: NodeTest>(kernel: K, nodes: &[Node8], leaves: &L, root:
     loop {
         if cur.count == 0 {
             let node = &nodes[cur.child as usize];
-            let (mut mask, _, _) = kernel.test(&lanes, node, t_max);
-            if mask != 0 {
-                let first = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                while mask != 0 {
-                    let l = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp] = MaybeUninit::new(Ref { child: node.child[l], count: node.count[l] });
-                    sp += 1;
-                }
-                cur = Ref { child: node.child[first], count: node.count[first] };
+            if let Some(next) = visit_any(kernel, &lanes, node, t_max, &mut stack, &mut sp) {
+                cur = next;
                 continue;
             }
         } else if leaves.any(cur, &mut q, t_max) {
@@ -87,7 +157,80 @@ fn any_hit<L: Leaves, K: NodeTest>(kernel: K, nodes: &[Node8], leaves: &L, root:
             return false;
         }
         sp -= 1;
-        // SAFETY: the entries below the stack pointer were written by the pushes above.
+        // SAFETY: the entries below the stack pointer were written by `visit_any`.
         cur = unsafe { stack[sp].assume_init() };
+    }
+}
+
+/// One ray's any-hit traversal as a state advanced one step at a time, for the batch.
+struct AnyWalk<'r> {
+    lanes: Lanes,
+    q: LeafRay<'r>,
+    t_max: f32,
+    stack: AnyStack,
+    sp: usize,
+    cur: Ref,
+    /// `Some(occluded)` once answered.
+    answer: Option<bool>,
+}
+
+impl<'r> Walker<'r> for AnyWalk<'r> {
+    type Out = bool;
+    const MISS: bool = false;
+
+    #[inline(always)]
+    fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
+        let lanes = Lanes::new(ray);
+        let major = lanes.major;
+        AnyWalk {
+            lanes,
+            q: LeafRay::new(ray, major),
+            t_max,
+            stack: [const { MaybeUninit::<Ref>::uninit() }; STACK],
+            sp: 0,
+            cur: root,
+            answer: None,
+        }
+    }
+
+    #[inline(always)]
+    fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
+        self.lanes = Lanes::new(ray);
+        self.q = LeafRay::new(ray, self.lanes.major);
+        self.t_max = t_max;
+        self.sp = 0;
+        self.cur = root;
+        self.answer = None;
+    }
+
+    #[inline(always)]
+    fn step<L: Leaves, K: NodeTest>(&mut self, kernel: K, nodes: &[Node8], leaves: &L) {
+        if self.cur.count == 0 {
+            let node = &nodes[self.cur.child as usize];
+            if let Some(next) = visit_any(kernel, &self.lanes, node, self.t_max, &mut self.stack, &mut self.sp) {
+                self.cur = next;
+                return;
+            }
+        } else if leaves.any(self.cur, &mut self.q, self.t_max) {
+            self.answer = Some(true);
+            return;
+        }
+        if self.sp == 0 {
+            self.answer = Some(false);
+            return;
+        }
+        self.sp -= 1;
+        // SAFETY: the entries below the stack pointer were written by `visit_any`.
+        self.cur = unsafe { self.stack[self.sp].assume_init() };
+    }
+
+    #[inline(always)]
+    fn done(&self) -> bool {
+        self.answer.is_some()
+    }
+
+    #[inline(always)]
+    fn answer(&self) -> bool {
+        self.answer == Some(true)
     }
 }

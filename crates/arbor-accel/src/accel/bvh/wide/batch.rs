@@ -1,9 +1,10 @@
-//! Closest-hit queries for a batch of rays on the 8-wide tree, two rays at once: one node visit of
-//! each in turn ([`Walk`]). A node visit is a chain of dependent loads and arithmetic that one ray
-//! cannot overlap with its next visit, which depends on it, but the other ray's visit can fill that
-//! wait. The node visit and the pop are those of the single query (`visit.rs`), so each ray visits the
-//! same nodes and gets the same hit as it would alone. The counted query and the any-hit query stay
-//! one ray at a time.
+//! Queries for a batch of rays on the 8-wide tree, two rays at once: one step of each in turn
+//! ([`Walker`]). A node visit is a chain of dependent loads and arithmetic that one ray cannot overlap
+//! with its next visit, which depends on it, but the other ray's visit can fill that wait. Closest hits
+//! ([`intersect_many`], whose walk is here) and any hits ([`super::occluded_many`], whose walk is in
+//! `any_hit.rs`) share the interleaving ([`many`]). Each walk's node visit and pop are those of its
+//! single query, so each ray visits the same nodes and gets the same answer as it would alone. The
+//! counted query stays one ray at a time.
 
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
@@ -57,84 +58,110 @@ impl Traversal for Batch<'_> {
 
     #[inline(always)]
     fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) {
-        many(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
+        many::<ClosestWalk, L, K>(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
     }
 }
 
-/// The interleaved closest-hit traversals of a batch, from `root`: two rays at once, in two named
-/// slots rather than an array, so that both walks' state stays in registers (more rays at once would
-/// not fit them).
+/// One ray's traversal as a state advanced one step at a time (a node visit, or a leaf and the pops
+/// after it), so that [`many`] can interleave two.
+pub(super) trait Walker<'r> {
+    /// The query's answer.
+    type Out: Copy;
+    /// The answer of a ray that trivially misses.
+    const MISS: Self::Out;
+    /// The walk of `ray` from `root`.
+    fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self;
+    /// Starts over with another ray (in place: the stack is not moved).
+    fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32);
+    /// One step.
+    fn step<L: Leaves, K: NodeTest>(&mut self, kernel: K, nodes: &[Node8], leaves: &L);
+    /// Whether the walk has its answer.
+    fn done(&self) -> bool;
+    /// The answer, once done.
+    fn answer(&self) -> Self::Out;
+}
+
+/// The interleaved traversals of a batch, from `root`: two rays at once, in two named slots rather
+/// than an array, so that both walks' state stays in registers (more rays at once would not fit them).
 #[inline(always)]
-fn many<L: Leaves, K: NodeTest>(
+pub(super) fn many<'r, W: Walker<'r>, L: Leaves, K: NodeTest>(
     kernel: K,
     nodes: &[Node8],
     leaves: &L,
     root: Ref,
-    rays: &[Ray],
+    rays: &'r [Ray],
     t_max: &[f32],
-    out: &mut [Option<Hit>],
+    out: &mut [W::Out],
 ) {
     let mut next = 0;
-    let Some(i) = next_ray(rays, t_max, out, &mut next) else { return };
-    let (mut ia, mut a) = (i, Walk::new(root, &rays[i], t_max[i]));
-    let Some(i) = next_ray(rays, t_max, out, &mut next) else {
-        out[ia] = a.finish(kernel, nodes, leaves);
+    let Some(i) = next_ray::<W>(rays, t_max, out, &mut next) else { return };
+    let (mut ia, mut a) = (i, W::new(root, &rays[i], t_max[i]));
+    let Some(i) = next_ray::<W>(rays, t_max, out, &mut next) else {
+        out[ia] = finish(&mut a, kernel, nodes, leaves);
         return;
     };
-    let (mut ib, mut b) = (i, Walk::new(root, &rays[i], t_max[i]));
+    let (mut ib, mut b) = (i, W::new(root, &rays[i], t_max[i]));
     // Both slots busy: step each in turn; a finished one takes the next ray, until none is left.
     loop {
         a.step(kernel, nodes, leaves);
         b.step(kernel, nodes, leaves);
-        if a.done && !refill(&mut a, &mut ia, root, rays, t_max, out, &mut next) {
-            out[ib] = b.finish(kernel, nodes, leaves);
+        if a.done() && !refill(&mut a, &mut ia, root, rays, t_max, out, &mut next) {
+            out[ib] = finish(&mut b, kernel, nodes, leaves);
             return;
         }
-        if b.done && !refill(&mut b, &mut ib, root, rays, t_max, out, &mut next) {
-            out[ia] = a.finish(kernel, nodes, leaves);
+        if b.done() && !refill(&mut b, &mut ib, root, rays, t_max, out, &mut next) {
+            out[ia] = finish(&mut a, kernel, nodes, leaves);
             return;
         }
     }
 }
 
-/// Hands finished walk `w`'s hit to `out[*i]` and starts it on the batch's next ray (its index into
+/// Hands finished walk `w`'s answer to `out[*i]` and starts it on the batch's next ray (its index into
 /// `*i`); false when no ray is left.
 #[inline(always)]
-fn refill<'r>(
-    w: &mut Walk<'r>,
+fn refill<'r, W: Walker<'r>>(
+    w: &mut W,
     i: &mut usize,
     root: Ref,
     rays: &'r [Ray],
     t_max: &[f32],
-    out: &mut [Option<Hit>],
+    out: &mut [W::Out],
     next: &mut usize,
 ) -> bool {
-    out[*i] = w.best.hit();
-    let Some(k) = next_ray(rays, t_max, out, next) else { return false };
+    out[*i] = w.answer();
+    let Some(k) = next_ray::<W>(rays, t_max, out, next) else { return false };
     *i = k;
     w.restart(root, &rays[k], t_max[k]);
     true
 }
 
 /// The index of the batch's next ray from `*next` on that needs a traversal; the rays skipped on the
-/// way trivially miss and get `None`.
+/// way trivially miss and get [`Walker::MISS`].
 #[inline(always)]
-fn next_ray(rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>], next: &mut usize) -> Option<usize> {
+fn next_ray<'r, W: Walker<'r>>(rays: &[Ray], t_max: &[f32], out: &mut [W::Out], next: &mut usize) -> Option<usize> {
     while *next < rays.len() {
         let i = *next;
         *next += 1;
         if !trivially_misses(&rays[i], t_max[i]) {
             return Some(i);
         }
-        out[i] = None;
+        out[i] = W::MISS;
     }
     None
 }
 
-/// One ray's closest-hit traversal as a state advanced one step at a time: a node visit, or a leaf and
-/// the pops after it. The single query (`closest.rs`) is the same traversal run to its end in one loop,
-/// which keeps its state in registers.
-struct Walk<'r> {
+/// Runs `w` to its end and returns its answer.
+#[inline(always)]
+fn finish<'r, W: Walker<'r>, L: Leaves, K: NodeTest>(w: &mut W, kernel: K, nodes: &[Node8], leaves: &L) -> W::Out {
+    while !w.done() {
+        w.step(kernel, nodes, leaves);
+    }
+    w.answer()
+}
+
+/// One ray's closest-hit traversal. The single query (`closest.rs`) is the same traversal run to its
+/// end in one loop, which keeps its state in registers.
+struct ClosestWalk<'r> {
     lanes: Lanes,
     q: LeafRay<'r>,
     best: ClosestHit,
@@ -144,12 +171,15 @@ struct Walk<'r> {
     done: bool,
 }
 
-impl<'r> Walk<'r> {
+impl<'r> Walker<'r> for ClosestWalk<'r> {
+    type Out = Option<Hit>;
+    const MISS: Option<Hit> = None;
+
     #[inline(always)]
     fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
         let lanes = Lanes::new(ray);
         let major = lanes.major;
-        Walk {
+        ClosestWalk {
             lanes,
             q: LeafRay::new(ray, major),
             best: ClosestHit::new(t_max),
@@ -160,7 +190,6 @@ impl<'r> Walk<'r> {
         }
     }
 
-    /// Starts over with another ray (in place: the stack is not moved).
     #[inline(always)]
     fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
         self.lanes = Lanes::new(ray);
@@ -197,12 +226,13 @@ impl<'r> Walk<'r> {
         }
     }
 
-    /// Runs the traversal to its end and returns its hit.
     #[inline(always)]
-    fn finish<L: Leaves, K: NodeTest>(&mut self, kernel: K, nodes: &[Node8], leaves: &L) -> Option<Hit> {
-        while !self.done {
-            self.step(kernel, nodes, leaves);
-        }
+    fn done(&self) -> bool {
+        self.done
+    }
+
+    #[inline(always)]
+    fn answer(&self) -> Option<Hit> {
         self.best.hit()
     }
 }

@@ -39,6 +39,9 @@ mod leaves;
 mod visit;
 
 pub(super) use any_hit::occluded;
+pub(super) use any_hit::occluded_many;
+#[cfg(test)]
+pub(super) use any_hit::occluded_many_with;
 #[cfg(test)]
 pub(super) use any_hit::occluded_with;
 pub(super) use batch::intersect_many;
