@@ -12,7 +12,11 @@
 //!
 //! The box test is the conservative test of the binary traversal (`../traverse.rs`), lane by lane:
 //! `near <= far + scale * SLACK` with `scale` the larger slab distance on the ray's major axis; `max`
-//! and `min` take the accumulator as the operand that wins over a NaN, as `f32::max`/`min` do.
+//! and `min` take the accumulator as the operand that wins over a NaN, as `f32::max`/`min` do. The
+//! major axis' slab distances are never NaN (a finite box or origin minus the other is never NaN, and
+//! the axis' reciprocal is finite and not zero: [`Ray::new`] flushes subnormal components, so the
+//! largest one is normal), so `scale` is one `max` of the two, with no accumulator to guard: the
+//! shortest chain for the slack, which the node's mask waits on.
 
 use super::{Node8, WIDTH};
 use crate::accel::BOX_SLACK;
@@ -168,8 +172,7 @@ fn test_avx2(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
         near = _mm256_max_ps(t0, near);
         far = _mm256_min_ps(t1, far);
         if a == lanes.major {
-            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), scale);
-            scale = _mm256_max_ps(_mm256_and_ps(t1, abs), scale);
+            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), _mm256_and_ps(t1, abs));
         }
     }
     let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
@@ -210,8 +213,7 @@ impl NodeTest for Sse {
                     near = _mm_max_ps(t0, near);
                     far = _mm_min_ps(t1, far);
                     if a == lanes.major {
-                        scale = _mm_max_ps(_mm_and_ps(t0, abs), scale);
-                        scale = _mm_max_ps(_mm_and_ps(t1, abs), scale);
+                        scale = _mm_max_ps(_mm_and_ps(t0, abs), _mm_and_ps(t1, abs));
                     }
                 }
                 let slack = _mm_mul_ps(scale, _mm_set1_ps(BOX_SLACK));
@@ -240,7 +242,7 @@ impl NodeTest for Scalar {
                 near = near.max(t0);
                 far = far.min(t1);
                 if a == lanes.major {
-                    scale = scale.max(t0.abs()).max(t1.abs());
+                    scale = t0.abs().max(t1.abs());
                 }
             }
             let slack = scale * BOX_SLACK;
