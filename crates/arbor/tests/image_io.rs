@@ -75,6 +75,20 @@ fn exr_round_trip_keeps_float_values() {
 }
 
 #[test]
+fn exr_files_are_the_same_bytes_for_the_same_pixels() {
+    // Blocks are compressed in parallel: written in increasing line order, not as they finish.
+    let dir = tempfile::tempdir().unwrap();
+    let film = level_film(700, 300);
+    let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
+    write_image(&a, &film).unwrap();
+    write_image(&b, &film).unwrap();
+    let bytes = fs::read(&a).unwrap();
+    assert!(bytes == fs::read(&b).unwrap(), "two writes of one film differ");
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).unwrap();
+    assert_eq!(meta.headers[0].line_order, exr::meta::attribute::LineOrder::Increasing);
+}
+
+#[test]
 fn write_quantises_half_levels_up_and_clamps() {
     let dir = tempfile::tempdir().unwrap();
     let mut film = Film::new(8, 1);

@@ -97,16 +97,19 @@ fn encode(film: &Film, format: Format) -> std::result::Result<Vec<u8>, String> {
     }
 }
 
-/// 32-bit float RGB through the exr crate, the writer of the farm's partial EXRs too.
+/// 32-bit float RGB through the exr crate, the writer of the farm's partial EXRs too. Its blocks are
+/// compressed in parallel; increasing line order makes it write them sorted, so the same pixels give
+/// the same file bytes on every run (the crate's default order is whichever block finished first).
 fn encode_exr(film: &Film) -> exr::error::Result<Vec<u8>> {
-    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    use exr::prelude::{Encoding, Image, LineOrder, SpecificChannels, Vec2, WritableImage};
     let w = film.width as usize;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let c = film.pixels[p.y() * w + p.x()];
         (c.x, c.y, c.z)
     });
     let mut out = Cursor::new(Vec::new());
-    Image::from_channels((w, film.height as usize), channels).write().to_buffered(&mut out)?;
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    Image::from_encoded_channels((w, film.height as usize), encoding, channels).write().to_buffered(&mut out)?;
     Ok(out.into_inner())
 }
 
