@@ -5,10 +5,10 @@
 
 use std::mem::MaybeUninit;
 
-use super::batch::{many, Walker};
+use super::batch::{Batch, Walker};
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
-use super::leaves::{LeafRay, Leaves};
+use super::leaves::{prepare, LeafRay, Leaves};
 use super::visit::STACK;
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::trivially_misses;
@@ -63,8 +63,7 @@ pub(in crate::accel::bvh) fn occluded_many_with<P: Primitives + ?Sized>(
     t_max: &[f32],
     out: &mut [bool],
 ) {
-    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and answers differ in length");
-    run_with(kernel, wide, indices, prims, AnyBatch { rays, t_max, out })
+    run_with(kernel, wide, indices, prims, Batch::<AnyWalk>::new(rays, t_max, out))
 }
 
 /// The any-hit query of one ray.
@@ -83,26 +82,6 @@ impl Traversal for AnyHit<'_> {
     #[inline(always)]
     fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) -> bool {
         !trivially_misses(self.ray, self.t_max) && any_hit(kernel, nodes, leaves, root, self.ray, self.t_max)
-    }
-}
-
-/// The any-hit queries of a batch.
-struct AnyBatch<'a> {
-    rays: &'a [Ray],
-    t_max: &'a [f32],
-    out: &'a mut [bool],
-}
-
-impl Traversal for AnyBatch<'_> {
-    type Out = ();
-
-    fn empty(self) {
-        self.out.fill(false);
-    }
-
-    #[inline(always)]
-    fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) {
-        many::<AnyWalk, L, K>(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
     }
 }
 
@@ -138,8 +117,7 @@ fn visit_any<K: NodeTest>(
 /// The any-hit traversal from `root`.
 #[inline(always)]
 fn any_hit<L: Leaves, K: NodeTest>(kernel: K, nodes: &[Node8], leaves: &L, root: Ref, ray: &Ray, t_max: f32) -> bool {
-    let lanes = Lanes::new(ray);
-    let mut q = LeafRay::new(ray, lanes.major);
+    let (lanes, mut q) = prepare(ray);
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;
     let mut cur = root;
@@ -180,11 +158,10 @@ impl<'r> Walker<'r> for AnyWalk<'r> {
 
     #[inline(always)]
     fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
-        let lanes = Lanes::new(ray);
-        let major = lanes.major;
+        let (lanes, q) = prepare(ray);
         AnyWalk {
             lanes,
-            q: LeafRay::new(ray, major),
+            q,
             t_max,
             stack: [const { MaybeUninit::<Ref>::uninit() }; STACK],
             sp: 0,
@@ -195,8 +172,7 @@ impl<'r> Walker<'r> for AnyWalk<'r> {
 
     #[inline(always)]
     fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
-        self.lanes = Lanes::new(ray);
-        self.q = LeafRay::new(ray, self.lanes.major);
+        (self.lanes, self.q) = prepare(ray);
         self.t_max = t_max;
         self.sp = 0;
         self.cur = root;

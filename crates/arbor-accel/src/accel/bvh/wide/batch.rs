@@ -6,9 +6,11 @@
 //! single query, so each ray visits the same nodes and gets the same answer as it would alone. The
 //! counted query stays one ray at a time.
 
+use std::marker::PhantomData;
+
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
-use super::leaves::{LeafRay, Leaves};
+use super::leaves::{prepare, LeafRay, Leaves};
 use super::visit::{new_stack, pop, visit, Stack};
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::{trivially_misses, ClosestHit};
@@ -38,27 +40,41 @@ pub(in crate::accel::bvh) fn intersect_many_with<P: Primitives + ?Sized>(
     t_max: &[f32],
     out: &mut [Option<Hit>],
 ) {
-    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and hits differ in length");
-    run_with(kernel, wide, indices, prims, Batch { rays, t_max, out })
+    run_with(kernel, wide, indices, prims, Batch::<ClosestWalk>::new(rays, t_max, out))
 }
 
-/// The closest-hit queries of a batch.
-struct Batch<'a> {
+/// The queries of a batch, each ray walked by a `W`.
+pub(super) struct Batch<'a, W: Walker<'a>> {
     rays: &'a [Ray],
     t_max: &'a [f32],
-    out: &'a mut [Option<Hit>],
+    out: &'a mut [W::Out],
+    walk: PhantomData<W>,
 }
 
-impl Traversal for Batch<'_> {
+impl<'a, W: Walker<'a>> Batch<'a, W> {
+    /// The batch `out[i]` = the answer for `rays[i]` in `(0, t_max[i])`.
+    ///
+    /// # Panics
+    /// When `rays`, `t_max` and `out` differ in length.
+    pub(super) fn new(rays: &'a [Ray], t_max: &'a [f32], out: &'a mut [W::Out]) -> Self {
+        assert!(
+            rays.len() == t_max.len() && rays.len() == out.len(),
+            "a batch's rays, t_max and answers differ in length"
+        );
+        Batch { rays, t_max, out, walk: PhantomData }
+    }
+}
+
+impl<'a, W: Walker<'a>> Traversal for Batch<'a, W> {
     type Out = ();
 
     fn empty(self) {
-        self.out.fill(None);
+        self.out.fill(W::MISS);
     }
 
     #[inline(always)]
     fn run<L: Leaves, K: NodeTest>(self, kernel: K, nodes: &[Node8], leaves: &L, root: Ref) {
-        many::<ClosestWalk, L, K>(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
+        many::<W, L, K>(kernel, nodes, leaves, root, self.rays, self.t_max, self.out)
     }
 }
 
@@ -84,7 +100,7 @@ pub(super) trait Walker<'r> {
 /// The interleaved traversals of a batch, from `root`: two rays at once, in two named slots rather
 /// than an array, so that both walks' state stays in registers (more rays at once would not fit them).
 #[inline(always)]
-pub(super) fn many<'r, W: Walker<'r>, L: Leaves, K: NodeTest>(
+fn many<'r, W: Walker<'r>, L: Leaves, K: NodeTest>(
     kernel: K,
     nodes: &[Node8],
     leaves: &L,
@@ -177,23 +193,13 @@ impl<'r> Walker<'r> for ClosestWalk<'r> {
 
     #[inline(always)]
     fn new(root: Ref, ray: &'r Ray, t_max: f32) -> Self {
-        let lanes = Lanes::new(ray);
-        let major = lanes.major;
-        ClosestWalk {
-            lanes,
-            q: LeafRay::new(ray, major),
-            best: ClosestHit::new(t_max),
-            stack: new_stack(),
-            sp: 0,
-            cur: root,
-            done: false,
-        }
+        let (lanes, q) = prepare(ray);
+        ClosestWalk { lanes, q, best: ClosestHit::new(t_max), stack: new_stack(), sp: 0, cur: root, done: false }
     }
 
     #[inline(always)]
     fn restart(&mut self, root: Ref, ray: &'r Ray, t_max: f32) {
-        self.lanes = Lanes::new(ray);
-        self.q = LeafRay::new(ray, self.lanes.major);
+        (self.lanes, self.q) = prepare(ray);
         self.best = ClosestHit::new(t_max);
         self.sp = 0;
         self.cur = root;

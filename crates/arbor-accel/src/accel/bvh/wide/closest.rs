@@ -7,8 +7,8 @@
 //! primitive index (`leaves.rs`).
 
 use super::dispatch::{run_with, Traversal};
-use super::kernel::{Kernel, Lanes, NodeTest};
-use super::leaves::{LeafRay, Leaves};
+use super::kernel::{Kernel, NodeTest};
+use super::leaves::{prepare, Leaves};
 use super::visit::{new_stack, pop, visit};
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::{trivially_misses, ClosestHit};
@@ -77,8 +77,7 @@ fn query<L: Leaves, K: NodeTest, const COUNT: bool>(
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    let lanes = Lanes::new(ray);
-    let mut q = LeafRay::new(ray, lanes.major);
+    let (lanes, mut q) = prepare(ray);
     let mut best = ClosestHit::new(t_max);
     let mut stack = new_stack();
     let mut sp = 0usize;

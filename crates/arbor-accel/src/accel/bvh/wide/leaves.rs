@@ -5,6 +5,7 @@
 //! Leaves ask for hits up to the float above the best `t` and keep ties by lowest primitive index
 //! ([`ClosestHit`]), so a leaf block's four-lane test gives brute force's hits bit for bit.
 
+use super::kernel::Lanes;
 use super::{LeafBlock, Ref};
 use crate::accel::closest::ClosestHit;
 use crate::accel::{Hit, PrimHit, Primitives, TraversalCounts};
@@ -44,6 +45,14 @@ impl<'a> LeafRay<'a> {
             RayFrame::with_major(ray, major)
         })
     }
+}
+
+/// `ray` prepared for a traversal: its lanes for the node tests and its view for the leaves.
+#[inline(always)]
+pub(super) fn prepare(ray: &Ray) -> (Lanes, LeafRay<'_>) {
+    let lanes = Lanes::new(ray);
+    let major = lanes.major;
+    (lanes, LeafRay::new(ray, major))
 }
 
 /// The leaves of a triangle mesh: blocks of four triangles in leaf order.
