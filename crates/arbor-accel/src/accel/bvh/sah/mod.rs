@@ -75,47 +75,53 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         }
         nodes.shrink_to_fit();
     }
-    let indices = live.iter().map(SahPrim::index).chain(dead).collect();
+    let mut indices = Vec::with_capacity(prims.len());
+    live.par_iter().map(SahPrim::index).collect_into_vec(&mut indices);
+    indices.extend(dead);
     let live = live.len();
     (nodes, indices, live)
 }
 
 /// The SAH builder's view of every primitive that can be hit, in index order, the indices of those that
 /// cannot (as [`split_live`]), and the root's boxes: one call to `bounds` per primitive, on chunks in
-/// parallel (concatenated in order: the same result for any thread count).
+/// parallel, each writing its live primitives at the front of its own part of the final array (so
+/// nothing is copied unless some primitive is dead: the same result for any thread count).
 fn sah_prims<P: Primitives + ?Sized>(prims: &P) -> (Vec<SahPrim>, Vec<u32>, Boxes) {
-    const CHUNK: usize = 1 << 16;
+    const CHUNK: usize = 1 << 14;
     let n = prims.len();
     assert!(n <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
-    let chunk = |range: std::ops::Range<usize>| {
-        let mut live = Vec::with_capacity(range.len());
-        let mut dead = Vec::new();
-        let mut boxes = Boxes::EMPTY;
-        for i in range {
-            let b = prims.bounds(i);
-            if usable(&b) {
-                let p = SahPrim::new(&b, i as u32);
-                boxes.add(&p);
-                live.push(p);
-            } else {
-                dead.push(i as u32);
+    let mut live = Vec::with_capacity(n);
+    let parts: Vec<(usize, Vec<u32>, Boxes)> = live.spare_capacity_mut()[..n]
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .map(|(c, out)| {
+            let (mut k, mut dead, mut boxes) = (0, Vec::new(), Boxes::EMPTY);
+            for i in c * CHUNK..c * CHUNK + out.len() {
+                let b = prims.bounds(i);
+                if usable(&b) {
+                    let p = SahPrim::new(&b, i as u32);
+                    boxes.add(&p);
+                    out[k].write(p);
+                    k += 1;
+                } else {
+                    dead.push(i as u32);
+                }
             }
+            (k, dead, boxes)
+        })
+        .collect();
+    let spare = live.spare_capacity_mut();
+    let mut len = 0;
+    for (c, &(k, _, _)) in parts.iter().enumerate() {
+        if len != c * CHUNK {
+            spare.copy_within(c * CHUNK..c * CHUNK + k, len);
         }
-        (live, dead, boxes)
-    };
-    if n <= CHUNK || rayon::current_num_threads() == 1 {
-        return chunk(0..n);
+        len += k;
     }
-    let parts: Vec<_> =
-        (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| chunk(c * CHUNK..(n.min((c + 1) * CHUNK)))).collect();
-    let mut live = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
-    let mut dead = Vec::new();
-    let mut boxes = Boxes::EMPTY;
-    for (l, d, b) in parts {
-        live.extend_from_slice(&l);
-        dead.extend_from_slice(&d);
-        boxes = boxes.union(b);
-    }
+    // SAFETY: each chunk wrote its first `k` entries, and they now sit, in chunk order, at `0..len`.
+    unsafe { live.set_len(len) };
+    let dead = parts.iter().flat_map(|p| p.1.iter().copied()).collect();
+    let boxes = parts.iter().fold(Boxes::EMPTY, |b, p| b.union(p.2));
     (live, dead, boxes)
 }
 
