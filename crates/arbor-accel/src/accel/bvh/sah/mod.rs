@@ -24,9 +24,12 @@
 //!
 //! On one thread the flat array is written directly, depth first. With more, nodes of at least
 //! [`PARALLEL_THRESHOLD`] primitives become a temporary tree of boxed nodes whose halves are built with
-//! `rayon::join`, smaller subtrees are written flat, and the whole is flattened at the end; since each
-//! half owns a disjoint slice of the primitive array and every decision depends only on that slice, the
-//! result is identical for any thread count.
+//! `rayon::join`, smaller subtrees are written flat, and the whole is flattened at the end (its parts
+//! in parallel too); since each half owns a disjoint slice of the primitive array and every decision
+//! depends only on that slice, the result is identical for any thread count. The few nodes at the top
+//! would leave threads idle while one bins them, so nodes of at least 2^15 primitives are binned in
+//! parallel (`bins.rs`: per-chunk bins merged, the same bins); their partition stays serial, since a
+//! parallel one would put the primitives in another order, and the order is part of the tree.
 //!
 //! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices are computed
 //! in single precision when the centroid extent and the bin scale are finite in it, else in double
@@ -135,7 +138,7 @@ fn build_node(prims: &mut [SahPrim], offset: usize, boxes: Boxes, depth: usize, 
         return BuildNode::Flat(out);
     }
     let bounds = boxes.bounds.aabb();
-    let Some(split) = find_split(prims, &boxes, depth, params, &mut Bins::new()) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, &mut Bins::new(), true) else {
         return make_leaf(bounds, offset, prims.len());
     };
     let (mid, axis, l_boxes, r_boxes) = partition(prims, split);
@@ -160,7 +163,7 @@ fn build_flat(
 ) -> u32 {
     let bounds = boxes.bounds.aabb();
     let index = out.len() as u32;
-    let Some(split) = find_split(prims, &boxes, depth, params, bins) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, bins, false) else {
         debug_assert!((1..=LEAF_HARD_MAX).contains(&prims.len()));
         out.push(Node::leaf(bounds, offset as u32, prims.len() as u16));
         return index;
@@ -174,8 +177,15 @@ fn build_flat(
     index
 }
 
-/// The split to make, or `None` for a leaf.
-fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams, bins: &mut Bins) -> Option<Split> {
+/// The split to make, or `None` for a leaf; `parallel`: a large node may be binned in parallel.
+fn find_split(
+    prims: &[SahPrim],
+    boxes: &Boxes,
+    depth: usize,
+    params: &BvhParams,
+    bins: &mut Bins,
+    parallel: bool,
+) -> Option<Split> {
     let n = prims.len();
     if n == 1 {
         return None;
@@ -190,7 +200,7 @@ fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams
         return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
     }
     let binner = Binner::new(axis, cb.min[axis], cb.max[axis], params.bins);
-    let best = best_bin(prims, &boxes.bounds, &binner, params, bins);
+    let best = best_bin(prims, &boxes.bounds, &binner, params, bins, parallel);
     if !best.cost.is_finite() {
         // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
         // but a range split keeps the recursion finite whatever the inputs.
