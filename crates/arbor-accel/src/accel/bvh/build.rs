@@ -19,6 +19,13 @@ use crate::math::{Aabb, Vec3};
 /// Nodes with at least this many primitives build their two children in parallel.
 pub(super) const PARALLEL_THRESHOLD: usize = 4096;
 
+/// True when the build runs on one thread (or under Miri, where starting rayon's pool breaks Stacked
+/// Borrows in crossbeam-epoch): then the builders take their serial paths, which give the same result
+/// without handing work to the pool (each hand-off wakes a pool thread and waits for it).
+pub(super) fn one_thread() -> bool {
+    cfg!(miri) || rayon::current_num_threads() == 1
+}
+
 /// What the builder knows about one primitive.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct BuildPrim {

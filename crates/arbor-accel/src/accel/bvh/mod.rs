@@ -198,10 +198,10 @@ impl Bvh {
         let drop = binary == Binary::DropForMesh && prims.triangle_mesh().is_some();
         // The statistics describe the binary tree, so when it is to be dropped they are taken now, as
         // part of the build, by a walk that needs nothing from the collapse: the two run side by side.
-        let (wide, dropped_stats) = rayon::join(
-            || Wide::collapse(&nodes, &prim_indices, prims),
-            || drop.then(|| binary_stats(&nodes, prim_indices.len(), kind, 0, Duration::ZERO)),
-        );
+        let collapse = || Wide::collapse(&nodes, &prim_indices, prims);
+        let stats = || drop.then(|| binary_stats(&nodes, prim_indices.len(), kind, 0, Duration::ZERO));
+        let (wide, dropped_stats) =
+            if build::one_thread() { (collapse(), stats()) } else { rayon::join(collapse, stats) };
         let bounds = nodes.first().map_or(Aabb::EMPTY, Node::bounds);
         let primitives = prim_indices.len();
         let mut bvh = Bvh {

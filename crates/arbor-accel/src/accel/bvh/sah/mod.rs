@@ -43,9 +43,11 @@
 mod bins;
 mod prim;
 
+use std::mem::MaybeUninit;
+
 use rayon::prelude::*;
 
-use super::build::{flatten, make_leaf, usable, BuildNode, PARALLEL_THRESHOLD};
+use super::build::{flatten, make_leaf, one_thread, usable, BuildNode, PARALLEL_THRESHOLD};
 use super::{BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
 use crate::accel::Primitives;
 use bins::{best_bin, Binner, Bins};
@@ -68,9 +70,8 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         // At most one node per primitive and one per leaf: pages reserved but never written cost
         // nothing, and shrinking in place copies nothing.
         nodes.reserve_exact(2 * live.len() - 1);
-        // Under Miri, too: starting rayon's pool there breaks Stacked Borrows in crossbeam-epoch, and
-        // both paths build the same tree.
-        if cfg!(miri) || rayon::current_num_threads() == 1 {
+        // Both paths build the same tree.
+        if one_thread() {
             // No parallelism to gain: the whole tree by the flat writer, straight into its array.
             build_flat(&mut live, 0, boxes, 0, params, &mut Bins::new(), &mut nodes);
         } else {
@@ -79,7 +80,11 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         nodes.shrink_to_fit();
     }
     let mut indices = Vec::with_capacity(prims.len());
-    live.par_iter().map(SahPrim::index).collect_into_vec(&mut indices);
+    if one_thread() {
+        indices.extend(live.iter().map(SahPrim::index));
+    } else {
+        live.par_iter().map(SahPrim::index).collect_into_vec(&mut indices);
+    }
     indices.extend(dead);
     let live = live.len();
     (nodes, indices, live)
@@ -94,25 +99,27 @@ fn sah_prims<P: Primitives + ?Sized>(prims: &P) -> (Vec<SahPrim>, Vec<u32>, Boxe
     let n = prims.len();
     assert!(n <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
     let mut live = Vec::with_capacity(n);
-    let parts: Vec<(usize, Vec<u32>, Boxes)> = live.spare_capacity_mut()[..n]
-        .par_chunks_mut(CHUNK)
-        .enumerate()
-        .map(|(c, out)| {
-            let (mut k, mut dead, mut boxes) = (0, Vec::new(), Boxes::EMPTY);
-            for i in c * CHUNK..c * CHUNK + out.len() {
-                let b = prims.bounds(i);
-                if usable(&b) {
-                    let p = SahPrim::new(&b, i as u32);
-                    boxes.add(&p);
-                    out[k].write(p);
-                    k += 1;
-                } else {
-                    dead.push(i as u32);
-                }
+    let chunk = |(c, out): (usize, &mut [MaybeUninit<SahPrim>])| {
+        let (mut k, mut dead, mut boxes) = (0, Vec::new(), Boxes::EMPTY);
+        for i in c * CHUNK..c * CHUNK + out.len() {
+            let b = prims.bounds(i);
+            if usable(&b) {
+                let p = SahPrim::new(&b, i as u32);
+                boxes.add(&p);
+                out[k].write(p);
+                k += 1;
+            } else {
+                dead.push(i as u32);
             }
-            (k, dead, boxes)
-        })
-        .collect();
+        }
+        (k, dead, boxes)
+    };
+    let spare = &mut live.spare_capacity_mut()[..n];
+    let parts: Vec<(usize, Vec<u32>, Boxes)> = if one_thread() {
+        spare.chunks_mut(CHUNK).enumerate().map(chunk).collect()
+    } else {
+        spare.par_chunks_mut(CHUNK).enumerate().map(chunk).collect()
+    };
     let spare = live.spare_capacity_mut();
     let mut len = 0;
     for (c, &(k, _, _)) in parts.iter().enumerate() {

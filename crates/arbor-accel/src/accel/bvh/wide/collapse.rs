@@ -1,30 +1,30 @@
-//! The collapse of a binary tree into the wide tree (what it produces: see the parent module).
+//! The collapse of a binary tree into the wide tree (what it produces: see the parent module). On one
+//! thread, the depth-first walk of `walk.rs`; on more, three passes ([`parallel`]) that give the walk's
+//! arrays byte for byte:
 //!
-//! On one thread, one depth-first walk ([`serial`]): each wide node is planned (which binary nodes
-//! become its children, which of its leaves get a lane per block: [`plan_node`]) and filled
-//! ([`fill`]: its lanes, and its leaves' triangles copied into blocks) when the walk reaches it; the
-//! slots of its inner children are taken then, consecutively, and its blocks appended.
+//! 1. Plan ([`plan`]): every wide node's children (which binary nodes it lifts, which of its leaves
+//!    get a lane per block: [`plan_node`], the walk's choices), its numbers of inner children and of
+//!    blocks, and the size of its subtree, in pre-order (the walk's order). A plan depends only on its
+//!    binary subtree, so large subtrees are planned in parallel and concatenated in order.
+//! 2. Place ([`place`]): the walk gives a node's inner children consecutive slots and appends its
+//!    blocks when it reaches the node, so a node's first child slot and first block are prefix sums
+//!    over the pre-order of those counts, and its own slot is its parent's first child slot plus its
+//!    rank among its parent's inner children. One serial pass over the plans (a few per hundred
+//!    triangles).
+//! 3. Fill ([`fill`]): every wide node and its blocks independently, in parallel, the blocks into
+//!    disjoint slices of the final array; the nodes come out in pre-order and are gathered into slot
+//!    order (a copy of the node array, a fifth of the bytes the blocks take).
 //!
-//! On more threads, three passes ([`parallel`]) that give that walk's arrays byte for byte:
-//! 1. Plan ([`plan`]): every wide node's plan, with its numbers of inner children and of blocks and
-//!    the size of its subtree, in pre-order (the walk's order). A plan depends only on its binary
-//!    subtree, so large subtrees are planned in parallel and concatenated in order.
-//! 2. Place ([`place`]): a node's first child slot and first block are then prefix sums over the
-//!    pre-order of those counts, and its own slot is its parent's first child slot plus its rank among
-//!    its parent's inner children. One serial pass over the plans (a few per hundred triangles).
-//! 3. Fill: every wide node and its blocks independently, in parallel, the blocks into disjoint
-//!    slices of the final array; the nodes come out in pre-order and are gathered into slot order (a
-//!    copy of the node array, a fifth of the bytes the blocks take).
-//!
-//! The walk stays for one thread because the passes read the binary tree twice (plan, then fill) and
-//! copy the nodes once more. Cost: linear in the binary tree's size (plus a sort of each split leaf's
-//! few triangles); the plans take 48 bytes per wide node.
+//! The passes read the binary tree twice (plan, then fill) and copy the nodes once more, so one
+//! thread keeps the walk. Cost: linear in the binary tree's size (plus a sort of each split leaf's few
+//! triangles); the plans take 48 bytes per wide node.
 
 use std::mem::MaybeUninit;
 
 use rayon::prelude::*;
 
 use super::{advise_huge_pages, LeafBlock, Node8, Ref, WIDTH};
+use crate::accel::bvh::build::one_thread;
 use crate::accel::bvh::{Node, LEAF_HARD_MAX};
 use crate::geometry::{Tri4, TriangleMesh};
 use crate::math::Aabb;
@@ -73,44 +73,8 @@ pub(super) fn collapse(
         return (Vec::new(), Ref { child: 0, count }, blocks);
     }
     let ctx = Ctx { bin, indices, mesh };
-    // Under Miri, too: starting rayon's pool there breaks Stacked Borrows in crossbeam-epoch.
-    let (nodes, blocks) = if cfg!(miri) || rayon::current_num_threads() == 1 { serial(&ctx) } else { parallel(&ctx) };
+    let (nodes, blocks) = if one_thread() { super::walk::collapse(bin, indices, mesh) } else { parallel(&ctx) };
     (nodes, Ref { child: 0, count: 0 }, blocks)
-}
-
-/// On one thread: each wide node planned and filled as a depth-first walk reaches it, in one pass over
-/// the binary tree (no plan array, no gather): the layout that [`parallel`] reproduces.
-fn serial(ctx: &Ctx) -> (Vec<Node8>, Vec<LeafBlock>) {
-    // Exact room for the blocks and an upper bound for the nodes (each wide node takes at least one
-    // binary inner node), so that neither array moves after its pages are advised.
-    let mut nodes = Vec::with_capacity(ctx.bin.len() / 2);
-    advise_huge_pages(&nodes);
-    let n_blocks = match ctx.mesh {
-        Some(_) => ctx.bin.iter().filter(|b| b.is_leaf()).map(|b| (b.count as usize).div_ceil(4)).sum(),
-        None => 0,
-    };
-    let mut blocks = Vec::with_capacity(n_blocks);
-    advise_huge_pages(&blocks);
-    nodes.push(Node8::EMPTY);
-    visit(ctx, 0, 0, &mut nodes, &mut blocks);
-    (nodes, blocks)
-}
-
-/// Writes the wide node that lifts binary inner node `i` into `slot` (already taken), and its blocks,
-/// then takes the slots of its inner children and visits them.
-fn visit(ctx: &Ctx, i: usize, slot: usize, nodes: &mut Vec<Node8>, blocks: &mut Vec<LeafBlock>) {
-    let p = plan_node(ctx.bin, ctx.mesh.is_some(), i);
-    let at = Place { slot: slot as u32, first_child: nodes.len() as u32, first_block: blocks.len() as u32 };
-    nodes.resize(nodes.len() + p.inner as usize, Node8::EMPTY);
-    let (len, add) = (blocks.len(), p.blocks as usize);
-    blocks.reserve(add);
-    nodes[slot] = fill(ctx, &p, &at, &mut blocks.spare_capacity_mut()[..add]);
-    // SAFETY: `fill` returned only after writing all `add` entries it was given (it asserts so).
-    unsafe { blocks.set_len(len + add) };
-    let inner = p.kids[..p.n as usize].iter().map(|&c| c as usize).filter(|&c| !ctx.bin[c].is_leaf());
-    for (slot, c) in (at.first_child as usize..).zip(inner) {
-        visit(ctx, c, slot, nodes, blocks);
-    }
 }
 
 /// On more threads: plan, place, fill (see the module documentation).

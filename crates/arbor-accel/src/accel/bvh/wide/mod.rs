@@ -26,7 +26,7 @@
 //! triangles; the collapse is linear in the binary tree's size (plus a sort of each split leaf's few
 //! triangles).
 //!
-//! The collapse is in `collapse.rs`. Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
+//! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
 //! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
 //! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
 //! (`batch.rs`) and the any-hit query (`any_hit.rs`).
@@ -40,6 +40,7 @@ mod dispatch;
 mod kernel;
 mod leaves;
 mod visit;
+mod walk;
 
 pub(super) use any_hit::occluded;
 #[cfg(test)]
