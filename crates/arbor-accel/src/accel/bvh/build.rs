@@ -8,6 +8,8 @@
 //! `rayon::join`; since each half owns a disjoint slice of the primitive array and every decision
 //! depends only on that slice, the tree is identical for any thread count.
 
+use std::mem::MaybeUninit;
+
 use rayon::prelude::*;
 
 use super::{Node, LEAF_HARD_MAX};
@@ -16,6 +18,13 @@ use crate::math::{Aabb, Vec3};
 
 /// Nodes with at least this many primitives build their two children in parallel.
 pub(super) const PARALLEL_THRESHOLD: usize = 4096;
+
+/// True when the build runs on one thread (or under Miri, where starting rayon's pool breaks Stacked
+/// Borrows in crossbeam-epoch): then the builders take their serial paths, which give the same result
+/// without handing work to the pool (each hand-off wakes a pool thread and waits for it).
+pub(super) fn one_thread() -> bool {
+    cfg!(miri) || rayon::current_num_threads() == 1
+}
 
 /// What the builder knows about one primitive.
 #[derive(Debug, Clone, Copy)]
@@ -100,21 +109,45 @@ pub(super) fn make_leaf(bounds: Aabb, offset: usize, count: usize) -> BuildNode 
     BuildNode::Leaf { bounds, first: offset as u32, count: count as u16 }
 }
 
-/// Appends `node`'s subtree depth first (first child right after its parent); returns its index.
-pub(super) fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> u32 {
-    let index = out.len();
+/// Appends `node`'s subtree depth first (first child right after its parent). The parts of the array
+/// that the two children of an inner node take are known from their sizes, so they are written in
+/// parallel.
+pub(super) fn flatten(node: &BuildNode, out: &mut Vec<Node>) {
+    let (start, len) = (out.len(), subtree_len(node));
+    out.reserve(len);
+    write(node, start as u32, &mut out.spare_capacity_mut()[..len]);
+    // SAFETY: `write` wrote every entry of the `len` it was given (asserted for flat parts; leaves
+    // and inner nodes take exactly their `subtree_len`).
+    unsafe { out.set_len(start + len) };
+}
+
+/// The number of nodes of `node`'s subtree. Called on each level of the boxed top of the tree only.
+fn subtree_len(node: &BuildNode) -> usize {
     match node {
-        BuildNode::Leaf { bounds, first, count } => out.push(Node::leaf(*bounds, *first, *count)),
+        BuildNode::Leaf { .. } => 1,
+        BuildNode::Inner { children, .. } => 1 + subtree_len(&children[0]) + subtree_len(&children[1]),
+        BuildNode::Flat(nodes) => nodes.len(),
+    }
+}
+
+/// Writes `node`'s subtree into `out`, all of it, as the nodes from index `base` on.
+fn write(node: &BuildNode, base: u32, out: &mut [MaybeUninit<Node>]) {
+    match node {
+        BuildNode::Leaf { bounds, first, count } => {
+            out[0].write(Node::leaf(*bounds, *first, *count));
+        }
         BuildNode::Inner { bounds, axis, children } => {
-            out.push(Node::inner(*bounds, 0, *axis));
-            flatten(&children[0], out);
-            let second = flatten(&children[1], out);
-            out[index] = Node::inner(*bounds, second, *axis);
+            let (head, rest) = out.split_first_mut().expect("an inner node takes at least three nodes");
+            let first = subtree_len(&children[0]);
+            let (l, r) = rest.split_at_mut(first);
+            head.write(Node::inner(*bounds, base + 1 + first as u32, *axis));
+            rayon::join(|| write(&children[0], base + 1, l), || write(&children[1], base + 1 + first as u32, r));
         }
         BuildNode::Flat(nodes) => {
-            let base = index as u32;
-            out.extend(nodes.iter().map(|n| if n.is_leaf() { *n } else { Node { offset: n.offset + base, ..*n } }));
+            assert_eq!(out.len(), nodes.len());
+            for (o, n) in out.iter_mut().zip(nodes) {
+                o.write(if n.is_leaf() { *n } else { Node { offset: n.offset + base, ..*n } });
+            }
         }
     }
-    index as u32
 }

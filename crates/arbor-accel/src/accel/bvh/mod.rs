@@ -195,7 +195,13 @@ impl Bvh {
         start: Instant,
         binary: Binary,
     ) -> Bvh {
-        let wide = Wide::collapse(&nodes, &prim_indices, prims);
+        let drop = binary == Binary::DropForMesh && prims.triangle_mesh().is_some();
+        // The statistics describe the binary tree, so when it is to be dropped they are taken now, as
+        // part of the build, by a walk that needs nothing from the collapse: the two run side by side.
+        let collapse = || Wide::collapse(&nodes, &prim_indices, prims);
+        let stats = || drop.then(|| binary_stats(&nodes, prim_indices.len(), kind, 0, Duration::ZERO));
+        let (wide, dropped_stats) =
+            if build::one_thread() { (collapse(), stats()) } else { rayon::join(collapse, stats) };
         let bounds = nodes.first().map_or(Aabb::EMPTY, Node::bounds);
         let primitives = prim_indices.len();
         let mut bvh = Bvh {
@@ -205,13 +211,11 @@ impl Bvh {
             primitives,
             bounds,
             wide,
-            dropped_stats: None,
+            dropped_stats,
             kind,
             build_time: Duration::ZERO,
         };
-        if binary == Binary::DropForMesh && bvh.wide.has_blocks() {
-            // The statistics describe the binary tree, so they are taken now, as part of the build.
-            bvh.dropped_stats = Some(bvh.compute_stats(kind, Duration::ZERO));
+        if drop {
             bvh.nodes = Vec::new();
             bvh.prim_indices = Vec::new();
         }
@@ -250,33 +254,44 @@ impl Bvh {
         if let Some(s) = &self.dropped_stats {
             return AccelStats { bytes, build_time, ..s.clone() };
         }
-        let mut tally = StatsTally::new(kind, self.prim_indices.len(), self.nodes.len(), bytes, build_time);
-        let Some(root) = self.nodes.first() else {
-            return tally.finish();
-        };
-        // Areas relative to the root's; a root of zero area (all primitives on one line or point)
-        // makes every node equally likely to be visited.
-        let root_area = root.bounds().area_f64();
-        let rel = |n: &Node| {
-            if root_area > 0.0 {
-                n.bounds().area_f64() / root_area
-            } else {
-                1.0
-            }
-        };
-        let mut stack = vec![(0usize, 0usize)];
-        while let Some((i, depth)) = stack.pop() {
-            let n = &self.nodes[i];
-            if n.is_leaf() {
-                tally.leaf(depth, n.count as usize, rel(n));
-            } else {
-                tally.inner(rel(n));
-                stack.push((i + 1, depth + 1));
-                stack.push((n.offset as usize, depth + 1));
-            }
-        }
-        tally.finish()
+        binary_stats(&self.nodes, self.prim_indices.len(), kind, bytes, build_time)
     }
+}
+
+/// The statistics of binary tree `nodes` over `primitives` primitives.
+fn binary_stats(
+    nodes: &[Node],
+    primitives: usize,
+    kind: &'static str,
+    bytes: usize,
+    build_time: Duration,
+) -> AccelStats {
+    let mut tally = StatsTally::new(kind, primitives, nodes.len(), bytes, build_time);
+    let Some(root) = nodes.first() else {
+        return tally.finish();
+    };
+    // Areas relative to the root's; a root of zero area (all primitives on one line or point)
+    // makes every node equally likely to be visited.
+    let root_area = root.bounds().area_f64();
+    let rel = |n: &Node| {
+        if root_area > 0.0 {
+            n.bounds().area_f64() / root_area
+        } else {
+            1.0
+        }
+    };
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((i, depth)) = stack.pop() {
+        let n = &nodes[i];
+        if n.is_leaf() {
+            tally.leaf(depth, n.count as usize, rel(n));
+        } else {
+            tally.inner(rel(n));
+            stack.push((i + 1, depth + 1));
+            stack.push((n.offset as usize, depth + 1));
+        }
+    }
+    tally.finish()
 }
 
 impl<P: Primitives + ?Sized> Accel<P> for Bvh {

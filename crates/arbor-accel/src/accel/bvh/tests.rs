@@ -166,7 +166,11 @@ fn bvh_depth_is_bounded_on_exponentially_spaced_centroids() {
 
 #[test]
 fn bvh_build_is_identical_for_any_thread_count() {
-    let mesh = soup(20_000, 12);
+    let mut mesh = soup(50_000, 12);
+    // Triangles that cannot be hit, spread over the setup pass's chunks, which then close the gaps.
+    for t in (7..50_000).step_by(4999) {
+        mesh.positions[3 * t] = Vec3::INFINITY;
+    }
     let on = |threads| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -175,8 +179,21 @@ fn bvh_build_is_identical_for_any_thread_count() {
             .install(|| Bvh::sah(&mesh, &BvhParams::default(), Binary::Keep))
     };
     let (one, four) = (on(1), on(4));
+    one.validate(&mesh).unwrap();
+    assert_eq!(one.prim_indices()[one.live..], (7..50_000).step_by(4999).map(|t| t as u32).collect::<Vec<_>>());
     assert_eq!(one.nodes(), four.nodes());
     assert_eq!(one.prim_indices(), four.prim_indices());
+    // The collapse too: large enough that the wide tree's top is planned in parallel.
+    assert!(one.nodes().len() >= 2 * wide::PLAN_PARALLEL, "{}", one.nodes().len());
+    let (w1, w4) = (one.wide(), four.wide());
+    assert_eq!(w1.nodes().len(), w4.nodes().len());
+    for (a, b) in w1.nodes().iter().zip(w4.nodes()) {
+        assert!(a.min == b.min && a.max == b.max && a.child == b.child && a.count == b.count);
+    }
+    assert_eq!(w1.blocks().len(), w4.blocks().len());
+    for (a, b) in w1.blocks().iter().zip(w4.blocks()) {
+        assert!(a.tris.v == b.tris.v && a.prim == b.prim);
+    }
 }
 
 #[test]

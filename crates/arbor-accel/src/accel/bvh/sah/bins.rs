@@ -2,6 +2,8 @@
 //! when it is exact enough, else double), the per-bin counts and boxes ([`Bins`]) and the sweep that
 //! prices every candidate plane ([`best_bin`]).
 
+use rayon::prelude::*;
+
 use super::prim::{BoxAcc, SahPrim};
 use crate::accel::bvh::{BvhParams, MAX_BINS};
 
@@ -71,6 +73,12 @@ pub(super) struct Best {
     pub(super) right: BoxAcc,
 }
 
+/// Nodes of at least this many primitives are binned in parallel when the builder asks for it: the
+/// top of the tree, whose few nodes would otherwise leave threads idle while one bins them all.
+const PARALLEL_BINNING: usize = 1 << 15;
+/// Primitives per parallel binning task.
+const PARALLEL_BIN_CHUNK: usize = 1 << 13;
+
 // The bins a node fills are tracked in a `u32` mask.
 const _: () = assert!(MAX_BINS <= 32);
 
@@ -88,7 +96,45 @@ impl Bins {
     }
 
     /// Adds `prims` to the bins; returns the mask of the bins filled.
-    fn fill<const A: usize>(&mut self, prims: &[SahPrim], binner: &Binner) -> u32 {
+    fn fill(&mut self, prims: &[SahPrim], binner: &Binner) -> u32 {
+        match binner.axis {
+            0 => self.fill_on::<0>(prims, binner),
+            1 => self.fill_on::<1>(prims, binner),
+            _ => self.fill_on::<2>(prims, binner),
+        }
+    }
+
+    /// [`Bins::fill`] on chunks of `prims` in parallel, each into bins of its own, merged at the end:
+    /// counts add and boxes unite, so the bins are the same whatever the chunks and their order.
+    fn fill_par(&mut self, prims: &[SahPrim], binner: &Binner) -> u32 {
+        let (part, mask) = prims
+            .par_chunks(PARALLEL_BIN_CHUNK)
+            .map(|chunk| {
+                let mut bins = Bins::new();
+                let mask = bins.fill(chunk, binner);
+                (bins, mask)
+            })
+            .reduce_with(|(mut a, ma), (b, mb)| {
+                a.merge(&b, mb);
+                (a, ma | mb)
+            })
+            .expect("a node to split has primitives");
+        self.merge(&part, mask);
+        mask
+    }
+
+    /// Adds bins `mask` of `other` to these.
+    fn merge(&mut self, other: &Bins, mask: u32) {
+        let mut rest = mask;
+        while rest != 0 {
+            let k = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            self.counts[k] += other.counts[k];
+            self.boxes[k] = self.boxes[k].union(other.boxes[k]);
+        }
+    }
+
+    fn fill_on<const A: usize>(&mut self, prims: &[SahPrim], binner: &Binner) -> u32 {
         let mut mask = 0u32;
         for p in prims {
             let k = binner.bin(p.centroid_on::<A>());
@@ -112,11 +158,12 @@ pub(super) fn best_bin(
     binner: &Binner,
     params: &BvhParams,
     bins: &mut Bins,
+    parallel: bool,
 ) -> Best {
-    let mask = match binner.axis {
-        0 => bins.fill::<0>(prims, binner),
-        1 => bins.fill::<1>(prims, binner),
-        _ => bins.fill::<2>(prims, binner),
+    let mask = if parallel && prims.len() >= PARALLEL_BINNING {
+        bins.fill_par(prims, binner)
+    } else {
+        bins.fill(prims, binner)
     };
     // The non-empty bins in order.
     let mut used = [0u8; MAX_BINS];

@@ -24,9 +24,12 @@
 //!
 //! On one thread the flat array is written directly, depth first. With more, nodes of at least
 //! [`PARALLEL_THRESHOLD`] primitives become a temporary tree of boxed nodes whose halves are built with
-//! `rayon::join`, smaller subtrees are written flat, and the whole is flattened at the end; since each
-//! half owns a disjoint slice of the primitive array and every decision depends only on that slice, the
-//! result is identical for any thread count.
+//! `rayon::join`, smaller subtrees are written flat, and the whole is flattened at the end (its parts
+//! in parallel too); since each half owns a disjoint slice of the primitive array and every decision
+//! depends only on that slice, the result is identical for any thread count. The few nodes at the top
+//! would leave threads idle while one bins them, so nodes of at least 2^15 primitives are binned in
+//! parallel (`bins.rs`: per-chunk bins merged, the same bins); their partition stays serial, since a
+//! parallel one would put the primitives in another order, and the order is part of the tree.
 //!
 //! Robustness: primitives with empty or non-finite bounds never enter the tree; bin indices are computed
 //! in single precision when the centroid extent and the bin scale are finite in it, else in double
@@ -40,9 +43,11 @@
 mod bins;
 mod prim;
 
+use std::mem::MaybeUninit;
+
 use rayon::prelude::*;
 
-use super::build::{flatten, make_leaf, usable, BuildNode, PARALLEL_THRESHOLD};
+use super::build::{flatten, make_leaf, one_thread, usable, BuildNode, PARALLEL_THRESHOLD};
 use super::{BvhParams, Node, LEAF_HARD_MAX, MAX_SAH_DEPTH};
 use crate::accel::Primitives;
 use bins::{best_bin, Binner, Bins};
@@ -65,9 +70,8 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         // At most one node per primitive and one per leaf: pages reserved but never written cost
         // nothing, and shrinking in place copies nothing.
         nodes.reserve_exact(2 * live.len() - 1);
-        // Under Miri, too: starting rayon's pool there breaks Stacked Borrows in crossbeam-epoch, and
-        // both paths build the same tree.
-        if cfg!(miri) || rayon::current_num_threads() == 1 {
+        // Both paths build the same tree.
+        if one_thread() {
             // No parallelism to gain: the whole tree by the flat writer, straight into its array.
             build_flat(&mut live, 0, boxes, 0, params, &mut Bins::new(), &mut nodes);
         } else {
@@ -75,47 +79,59 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
         }
         nodes.shrink_to_fit();
     }
-    let indices = live.iter().map(SahPrim::index).chain(dead).collect();
+    let mut indices = Vec::with_capacity(prims.len());
+    if one_thread() {
+        indices.extend(live.iter().map(SahPrim::index));
+    } else {
+        live.par_iter().map(SahPrim::index).collect_into_vec(&mut indices);
+    }
+    indices.extend(dead);
     let live = live.len();
     (nodes, indices, live)
 }
 
 /// The SAH builder's view of every primitive that can be hit, in index order, the indices of those that
 /// cannot (as [`split_live`]), and the root's boxes: one call to `bounds` per primitive, on chunks in
-/// parallel (concatenated in order: the same result for any thread count).
+/// parallel, each writing its live primitives at the front of its own part of the final array (so
+/// nothing is copied unless some primitive is dead: the same result for any thread count).
 fn sah_prims<P: Primitives + ?Sized>(prims: &P) -> (Vec<SahPrim>, Vec<u32>, Boxes) {
-    const CHUNK: usize = 1 << 16;
+    const CHUNK: usize = 1 << 14;
     let n = prims.len();
     assert!(n <= u32::MAX as usize, "a BVH indexes at most 2^32 - 1 primitives");
-    let chunk = |range: std::ops::Range<usize>| {
-        let mut live = Vec::with_capacity(range.len());
-        let mut dead = Vec::new();
-        let mut boxes = Boxes::EMPTY;
-        for i in range {
+    let mut live = Vec::with_capacity(n);
+    let chunk = |(c, out): (usize, &mut [MaybeUninit<SahPrim>])| {
+        let (mut k, mut dead, mut boxes) = (0, Vec::new(), Boxes::EMPTY);
+        for i in c * CHUNK..c * CHUNK + out.len() {
             let b = prims.bounds(i);
             if usable(&b) {
                 let p = SahPrim::new(&b, i as u32);
                 boxes.add(&p);
-                live.push(p);
+                out[k].write(p);
+                k += 1;
             } else {
                 dead.push(i as u32);
             }
         }
-        (live, dead, boxes)
+        (k, dead, boxes)
     };
-    if n <= CHUNK || rayon::current_num_threads() == 1 {
-        return chunk(0..n);
+    let spare = &mut live.spare_capacity_mut()[..n];
+    let parts: Vec<(usize, Vec<u32>, Boxes)> = if one_thread() {
+        spare.chunks_mut(CHUNK).enumerate().map(chunk).collect()
+    } else {
+        spare.par_chunks_mut(CHUNK).enumerate().map(chunk).collect()
+    };
+    let spare = live.spare_capacity_mut();
+    let mut len = 0;
+    for (c, &(k, _, _)) in parts.iter().enumerate() {
+        if len != c * CHUNK {
+            spare.copy_within(c * CHUNK..c * CHUNK + k, len);
+        }
+        len += k;
     }
-    let parts: Vec<_> =
-        (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| chunk(c * CHUNK..(n.min((c + 1) * CHUNK)))).collect();
-    let mut live = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
-    let mut dead = Vec::new();
-    let mut boxes = Boxes::EMPTY;
-    for (l, d, b) in parts {
-        live.extend_from_slice(&l);
-        dead.extend_from_slice(&d);
-        boxes = boxes.union(b);
-    }
+    // SAFETY: each chunk wrote its first `k` entries, and they now sit, in chunk order, at `0..len`.
+    unsafe { live.set_len(len) };
+    let dead = parts.iter().flat_map(|p| p.1.iter().copied()).collect();
+    let boxes = parts.iter().fold(Boxes::EMPTY, |b, p| b.union(p.2));
     (live, dead, boxes)
 }
 
@@ -129,7 +145,7 @@ fn build_node(prims: &mut [SahPrim], offset: usize, boxes: Boxes, depth: usize, 
         return BuildNode::Flat(out);
     }
     let bounds = boxes.bounds.aabb();
-    let Some(split) = find_split(prims, &boxes, depth, params, &mut Bins::new()) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, &mut Bins::new(), true) else {
         return make_leaf(bounds, offset, prims.len());
     };
     let (mid, axis, l_boxes, r_boxes) = partition(prims, split);
@@ -154,7 +170,7 @@ fn build_flat(
 ) -> u32 {
     let bounds = boxes.bounds.aabb();
     let index = out.len() as u32;
-    let Some(split) = find_split(prims, &boxes, depth, params, bins) else {
+    let Some(split) = find_split(prims, &boxes, depth, params, bins, false) else {
         debug_assert!((1..=LEAF_HARD_MAX).contains(&prims.len()));
         out.push(Node::leaf(bounds, offset as u32, prims.len() as u16));
         return index;
@@ -168,8 +184,15 @@ fn build_flat(
     index
 }
 
-/// The split to make, or `None` for a leaf.
-fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams, bins: &mut Bins) -> Option<Split> {
+/// The split to make, or `None` for a leaf; `parallel`: a large node may be binned in parallel.
+fn find_split(
+    prims: &[SahPrim],
+    boxes: &Boxes,
+    depth: usize,
+    params: &BvhParams,
+    bins: &mut Bins,
+    parallel: bool,
+) -> Option<Split> {
     let n = prims.len();
     if n == 1 {
         return None;
@@ -184,7 +207,7 @@ fn find_split(prims: &[SahPrim], boxes: &Boxes, depth: usize, params: &BvhParams
         return (n > params.max_leaf_prims).then_some(Split::Middle { axis });
     }
     let binner = Binner::new(axis, cb.min[axis], cb.max[axis], params.bins);
-    let best = best_bin(prims, &boxes.bounds, &binner, params, bins);
+    let best = best_bin(prims, &boxes.bounds, &binner, params, bins, parallel);
     if !best.cost.is_finite() {
         // No plane has primitives on both sides; cannot happen while the centroid extent is positive,
         // but a range split keeps the recursion finite whatever the inputs.

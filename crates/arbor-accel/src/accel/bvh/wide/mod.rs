@@ -8,7 +8,9 @@
 //! Collapse: starting from a binary node's two children, the inner child with the largest surface area
 //! is repeatedly replaced by its own two children until there are eight, or only leaves (the SAH
 //! probability of being visited decides which level to skip). Leaves keep their ranges of the binary
-//! tree's primitive order.
+//! tree's primitive order. The nodes are laid out as a depth-first walk writes them (a node's inner
+//! children in consecutive slots, taken when the node is visited), whatever the thread count:
+//! `collapse.rs` plans, places and fills them in parallel and gets that layout byte for byte.
 //!
 //! When the primitives are a triangle mesh ([`Primitives::triangle_mesh`]), the corners of every
 //! leaf's triangles are copied, in leaf order, into blocks of four SIMD lanes ([`LeafBlock`]), so the
@@ -24,7 +26,7 @@
 //! triangles; the collapse is linear in the binary tree's size (plus a sort of each split leaf's few
 //! triangles).
 //!
-//! Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
+//! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
 //! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
 //! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
 //! (`batch.rs`) and the any-hit query (`any_hit.rs`).
@@ -33,10 +35,12 @@ mod any_hit;
 mod batch;
 mod check;
 mod closest;
+mod collapse;
 mod dispatch;
 mod kernel;
 mod leaves;
 mod visit;
+mod walk;
 
 pub(super) use any_hit::occluded;
 pub(super) use any_hit::occluded_many;
@@ -51,13 +55,14 @@ pub(super) use closest::intersect;
 #[cfg(test)]
 pub(super) use closest::intersect_with;
 #[cfg(test)]
+pub(super) use collapse::PLAN_PARALLEL;
+#[cfg(test)]
 pub(super) use kernel::Avx2;
 pub(super) use kernel::Kernel;
 
 use super::Node;
 use crate::accel::Primitives;
-use crate::geometry::{Tri4, TriangleMesh};
-use crate::math::Aabb;
+use crate::geometry::Tri4;
 
 /// Children per wide node.
 pub const WIDTH: usize = 8;
@@ -125,149 +130,15 @@ pub struct Wide {
     blocks: Option<Vec<LeafBlock>>,
 }
 
-/// What the collapse reads and writes.
-struct Collapse<'a> {
-    bin: &'a [Node],
-    indices: &'a [u32],
-    mesh: Option<&'a TriangleMesh>,
-    nodes: Vec<Node8>,
-    blocks: Vec<LeafBlock>,
-}
-
-impl Collapse<'_> {
-    /// The reference to binary leaf `b`, copying its triangles into blocks for a mesh.
-    fn leaf(&mut self, b: &Node) -> Ref {
-        let count = b.count as u32;
-        let Some(mesh) = self.mesh else { return Ref { child: b.offset, count } };
-        let first = self.blocks.len() as u32;
-        let range = b.offset as usize..b.offset as usize + b.count as usize;
-        for ids in self.indices[range].chunks(4) {
-            push_block(&mut self.blocks, mesh, ids);
-        }
-        Ref { child: first, count }
-    }
-
-    /// Binary leaf `b` of a mesh as one reference per block of four triangles, each with the box of its
-    /// own triangles: the leaf's triangles sorted along its box's longest axis, then cut into blocks,
-    /// so that each block is a compact piece of the leaf (a ray that meets the leaf's box often meets
-    /// only one of them).
-    fn split_leaf(&mut self, b: &Node, mesh: &TriangleMesh) -> Vec<(Aabb, Ref)> {
-        let axis = b.bounds().longest_axis();
-        let mut ids: Vec<u32> = self.indices[b.offset as usize..b.offset as usize + b.count as usize].to_vec();
-        let key = |i: u32| {
-            let [p0, p1, p2] = mesh.triangle(i as usize);
-            p0[axis] + p1[axis] + p2[axis]
-        };
-        ids.sort_by(|&x, &y| key(x).total_cmp(&key(y)).then(x.cmp(&y)));
-        ids.chunks(4)
-            .map(|chunk| {
-                let bounds = Aabb::from_points(chunk.iter().flat_map(|&i| mesh.triangle(i as usize)));
-                (bounds, Ref { child: push_block(&mut self.blocks, mesh, chunk), count: chunk.len() as u32 })
-            })
-            .collect()
-    }
-
-    /// Writes the wide node for binary inner node `i` at `index` (already reserved), then its subtree.
-    /// The inner children of a node get consecutive slots, as in Embree: a ray that enters several of
-    /// them reads neighbouring memory.
-    fn node(&mut self, index: usize, i: usize) {
-        let bin = self.bin;
-        let mut kids = [0usize; WIDTH];
-        kids[0] = i + 1;
-        kids[1] = bin[i].offset as usize;
-        let mut n = 2;
-        while n < WIDTH {
-            // Open the inner child most likely to be visited.
-            let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
-                let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
-                sa.total_cmp(&sb)
-            });
-            let Some(k) = best else { break };
-            let open = kids[k];
-            kids[k] = open + 1;
-            kids[n] = bin[open].offset as usize;
-            n += 1;
-        }
-        // Lanes left over go to the blocks of leaves of more than one block, largest leaves first:
-        // a lane costs nothing in the node test, and a block behind its own box is tested only by
-        // rays that meet that box.
-        let mut split = [false; WIDTH];
-        if self.mesh.is_some() {
-            let mut free = WIDTH - n;
-            let mut leaves: Vec<usize> = (0..n).filter(|&k| bin[kids[k]].count > 4).collect();
-            leaves.sort_by(|&a, &b| bin[kids[b]].bounds().area_f64().total_cmp(&bin[kids[a]].bounds().area_f64()));
-            for k in leaves {
-                let extra = (bin[kids[k]].count as usize).div_ceil(4) - 1;
-                if extra <= free {
-                    free -= extra;
-                    split[k] = true;
-                }
-            }
-        }
-        let mut node = Node8::EMPTY;
-        let mut inner = [(0usize, 0usize); WIDTH];
-        let mut n_inner = 0;
-        let mut lane = 0;
-        let mut put = |node: &mut Node8, bounds: Aabb, r: Ref| {
-            for a in 0..3 {
-                node.min[a][lane] = bounds.min[a];
-                node.max[a][lane] = bounds.max[a];
-            }
-            node.child[lane] = r.child;
-            node.count[lane] = r.count;
-            lane += 1;
-        };
-        for (k, &c) in kids[..n].iter().enumerate() {
-            let b = &bin[c];
-            if split[k] {
-                let mesh = self.mesh.expect("only mesh leaves are split");
-                for (bounds, r) in self.split_leaf(b, mesh) {
-                    put(&mut node, bounds, r);
-                }
-                continue;
-            }
-            let r = if b.is_leaf() {
-                self.leaf(b)
-            } else {
-                let slot = self.nodes.len();
-                self.nodes.push(Node8::EMPTY);
-                inner[n_inner] = (slot, c);
-                n_inner += 1;
-                Ref { child: slot as u32, count: 0 }
-            };
-            put(&mut node, b.bounds(), r);
-        }
-        self.nodes[index] = node;
-        for &(slot, c) in &inner[..n_inner] {
-            self.node(slot, c);
-        }
-    }
-}
-
 impl Wide {
     /// Collapses the binary tree `bin` (depth-first layout) whose leaves refer to `indices`.
     pub(super) fn collapse<P: Primitives + ?Sized>(bin: &[Node], indices: &[u32], prims: &P) -> Wide {
         let mesh = prims.triangle_mesh();
-        let mut c = Collapse { bin, indices, mesh, nodes: Vec::new(), blocks: Vec::new() };
-        let root = match bin.first() {
-            None => None,
-            Some(root) if root.is_leaf() => Some(c.leaf(root)),
-            Some(_) => {
-                // Exact room for the blocks and an upper bound for the nodes (each wide node takes at
-                // least one binary inner node), so that neither array moves after its pages are advised.
-                c.nodes = Vec::with_capacity(bin.len() / 2);
-                advise_huge_pages(&c.nodes);
-                if mesh.is_some() {
-                    let blocks = bin.iter().filter(|b| b.is_leaf()).map(|b| (b.count as usize).div_ceil(4)).sum();
-                    c.blocks = Vec::with_capacity(blocks);
-                    advise_huge_pages(&c.blocks);
-                }
-                c.nodes.push(Node8::EMPTY);
-                c.node(0, 0);
-                Some(Ref { child: 0, count: 0 })
-            }
-        };
-        Wide { nodes: c.nodes, root, blocks: mesh.map(|_| c.blocks) }
+        if bin.is_empty() {
+            return Wide { nodes: Vec::new(), root: None, blocks: mesh.map(|_| Vec::new()) };
+        }
+        let (nodes, root, blocks) = collapse::collapse(bin, indices, mesh);
+        Wide { nodes, root: Some(root), blocks: mesh.map(|_| blocks) }
     }
 
     /// Bytes of the wide nodes and the triangle blocks.
@@ -285,15 +156,6 @@ impl Wide {
     pub fn blocks(&self) -> &[LeafBlock] {
         self.blocks.as_deref().unwrap_or(&[])
     }
-}
-
-/// Appends the block of triangles `ids` (one to four) to `blocks`; returns its index. Lanes past the
-/// last triangle repeat it (the traversal never tests them).
-fn push_block(blocks: &mut Vec<LeafBlock>, mesh: &TriangleMesh, ids: &[u32]) -> u32 {
-    let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
-    let tris = prim.map(|i| mesh.triangle(i as usize));
-    blocks.push(LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim });
-    blocks.len() as u32 - 1
 }
 
 /// Asks Linux to back the 2 MiB-aligned part of `v`'s allocation with transparent huge pages, as
