@@ -307,7 +307,7 @@ fn footprint(width: f32, dir: Vec3, ng: Vec3, at: &TexPoint, to_world: Option<&T
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal
 /// interpolates the vertex normals of smooth meshes.
-#[inline]
+#[inline(always)]
 fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
     let i = hit.sub as usize;
     let [a, b, c] = mesh.triangle(i);
