@@ -133,6 +133,7 @@ impl Scene {
     }
 
     /// Shading data for `hit`, found on `ray`.
+    #[inline]
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
         let g = &self.geometry;
         let mut p = ray.at(hit.t);
