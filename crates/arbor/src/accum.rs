@@ -9,7 +9,8 @@
 //!
 //! Invariants: a sample is clamped to `±2^62` and NaN counts as 0 before rounding (truncation towards
 //! zero below `2^-64`), so at most 2^34 samples (the scene limit) can never overflow an `i128`. Cost:
-//! one float-to-int conversion per channel and sample, negligible next to tracing the sample's rays.
+//! one shift of the float's significand per channel and sample, negligible next to tracing the sample's
+//! rays.
 
 use crate::math::Color;
 
@@ -47,12 +48,30 @@ impl SampleSum {
     }
 }
 
-/// One channel of one sample in fixed point.
+/// One channel of one sample in fixed point: `v · 2^64` truncated towards zero, as
+/// `(v as f64 * 2^64) as i128` gives it, from the float's own bits (the 24-bit significand shifted by
+/// the exponent), without the library's generic float-to-`i128` conversion.
 #[inline]
 fn to_fixed(v: f32) -> i128 {
     let v = if v.is_nan() { 0.0 } else { v.clamp(-CLAMP, CLAMP) };
-    // Exact: a power-of-two scale of a finite value below 2^62; `as` truncates the bits below 2^-64.
-    (v as f64 * ONE) as i128
+    let bits = v.to_bits();
+    let biased = ((bits >> 23) & 0xff) as i32;
+    let significand = (bits & 0x7f_ffff) | if biased == 0 { 0 } else { 0x80_0000 };
+    // |v| = significand · 2^(e - 150), e the biased exponent (1 for subnormals); times 2^64. At most
+    // 2^62 · 2^64 < 2^127 after the clamp.
+    let shift = biased.max(1) - 86;
+    let magnitude = if shift >= 0 {
+        (significand as i128) << shift
+    } else if shift > -32 {
+        (significand >> -shift) as i128
+    } else {
+        0
+    };
+    if bits >> 31 == 0 {
+        magnitude
+    } else {
+        -magnitude
+    }
 }
 
 /// A fixed-point sum rounded to `f32` (through `f64`: deterministic, which is all that matters here).
@@ -76,6 +95,30 @@ mod tests {
             samples[split..].iter().for_each(|&v| b.add_sample(Color::splat(v)));
             b.add(&a);
             assert_eq!(b, whole);
+        }
+    }
+
+    #[test]
+    fn accum_to_fixed_truncates_as_the_float_conversion_does() {
+        let reference = |v: f32| {
+            let v = if v.is_nan() { 0.0 } else { v.clamp(-CLAMP, CLAMP) };
+            (v as f64 * ONE) as i128
+        };
+        let mut special =
+            vec![0.0, -0.0, 1.0, -1.0, 0.5, 1.5, 3.0e-7, f32::MIN_POSITIVE, -f32::MIN_POSITIVE, f32::EPSILON];
+        special.extend([CLAMP, -CLAMP, f32::MAX, f32::MIN, f32::INFINITY, f32::NEG_INFINITY, f32::NAN]);
+        // 2^-64 and its neighbours: the smallest values that do not truncate to zero.
+        let unit = (1.0f64 / ONE) as f32;
+        special.extend([unit, unit.next_up(), unit.next_down(), -unit, -unit.next_down(), 1.0e-40, -1.0e-40]);
+        for v in special {
+            assert_eq!(to_fixed(v), reference(v), "{v:e}");
+        }
+        // Every exponent, and a spread of significands and signs (a Weyl sequence over the bit patterns).
+        let mut bits = 0u32;
+        for _ in 0..2_000_000 {
+            bits = bits.wrapping_add(0x9e37_79b9);
+            let v = f32::from_bits(bits);
+            assert_eq!(to_fixed(v), reference(v), "{v:e} ({bits:#x})");
         }
     }
 

@@ -33,7 +33,7 @@ use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
 use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
 use crate::renderer::Renderer;
-use crate::sampler::{pixel_offset, Rng};
+use crate::sampler::{Rng, Strata};
 use crate::scene::Scene;
 
 const TILE: u32 = 16;
@@ -226,6 +226,7 @@ fn trace(
     let done = AtomicU64::new(0);
     let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
     let moving = scene.geometry.has_motion();
+    let strata = Strata::new(spp);
 
     let traced: Result<Traced> = tiles
         .par_iter()
@@ -247,7 +248,7 @@ fn trace(
                 for &(x, y) in group {
                     for k in k0..k1 {
                         let mut rng = Rng::for_sample(x, y, k, opts.seed);
-                        let offset = pixel_offset(k, spp, &mut rng);
+                        let offset = strata.offset(k, &mut rng);
                         let mut ray = cam.ray(x, y, offset, rng.next_2d());
                         // A time is drawn only when something moves, so still scenes keep their streams.
                         if moving {

@@ -56,27 +56,49 @@ fn mix(mut z: u64) -> u64 {
 /// a jittered point in cell `k` of a `cols x rows` grid (`cols = ceil(sqrt(n))`, `rows = ceil(n / cols)`).
 /// When `n` does not fill that grid (`--spp 10`: 4 x 3 cells for 10 samples), the `rows` rows hold
 /// `n / rows` or one more samples each and are as tall as their share of the samples, so that every cell
-/// still covers `1/n` of the pixel and the estimate stays unbiased.
+/// still covers `1/n` of the pixel and the estimate stays unbiased. [`Strata`] is the same with the grid
+/// worked out once.
 pub fn pixel_offset(k: u32, n: u32, rng: &mut Rng) -> Vec2 {
-    if n <= 1 {
-        return Vec2::splat(0.5);
+    Strata::new(n).offset(k, rng)
+}
+
+/// The stratification of `n` samples per pixel ([`pixel_offset`]), worked out once per render.
+#[derive(Debug, Clone, Copy)]
+pub struct Strata {
+    n: u32,
+    cols: u32,
+    rows: u32,
+}
+
+impl Strata {
+    /// The grid of `n` samples per pixel.
+    pub fn new(n: u32) -> Self {
+        let cols = if n <= 1 { 1 } else { (n as f32).sqrt().ceil() as u32 };
+        Strata { n, cols, rows: n.div_ceil(cols) }
     }
-    let cols = (n as f32).sqrt().ceil() as u32;
-    let rows = n.div_ceil(cols);
-    if cols * rows == n {
-        let cell = Vec2::new((k % cols) as f32, (k / cols) as f32);
-        return (cell + rng.next_2d()) / Vec2::new(cols as f32, rows as f32);
+
+    /// The offset of sample `k` ([`pixel_offset`]).
+    #[inline]
+    pub fn offset(&self, k: u32, rng: &mut Rng) -> Vec2 {
+        let Strata { n, cols, rows } = *self;
+        if n <= 1 {
+            return Vec2::splat(0.5);
+        }
+        if cols * rows == n {
+            let cell = Vec2::new((k % cols) as f32, (k / cols) as f32);
+            return (cell + rng.next_2d()) / Vec2::new(cols as f32, rows as f32);
+        }
+        // The first `n % rows` rows hold one sample more than the others.
+        let (short, long) = (n / rows, n / rows + 1);
+        let long_rows = n % rows;
+        let (row, col, len) = match k.checked_sub(long_rows * long) {
+            None => (k / long, k % long, long),
+            Some(j) => (long_rows + j / short, j % short, short),
+        };
+        let first = row * short + row.min(long_rows);
+        let r = rng.next_2d();
+        Vec2::new((col as f32 + r.x) / len as f32, (first as f32 + r.y * len as f32) / n as f32)
     }
-    // The first `n % rows` rows hold one sample more than the others.
-    let (short, long) = (n / rows, n / rows + 1);
-    let long_rows = n % rows;
-    let (row, col, len) = match k.checked_sub(long_rows * long) {
-        None => (k / long, k % long, long),
-        Some(j) => (long_rows + j / short, j % short, short),
-    };
-    let first = row * short + row.min(long_rows);
-    let r = rng.next_2d();
-    Vec2::new((col as f32 + r.x) / len as f32, (first as f32 + r.y * len as f32) / n as f32)
 }
 
 #[cfg(test)]

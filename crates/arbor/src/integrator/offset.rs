@@ -14,12 +14,19 @@ use crate::scene::{RayOffset, Surface};
 
 /// The origin of a ray leaving surface `s` towards the side of `side` (the new ray's direction, or any
 /// vector on the side it leaves from, relative to the geometric normal), under the scene's `offset`.
-#[inline]
+#[inline(always)]
 pub fn spawn_origin(offset: RayOffset, s: &Surface, side: Vec3) -> Vec3 {
     match offset {
         RayOffset::ShadowEpsilon(epsilon) => s.p + if side.dot(s.ng) > 0.0 { s.ng } else { -s.ng } * epsilon,
-        RayOffset::ErrorBound => offset_ray_origin(s.p, s.p_error, s.ng, side),
+        RayOffset::ErrorBound => error_bound_origin(s, side),
     }
+}
+
+/// [`offset_ray_origin`] of `s`, out of line, so that [`spawn_origin`] stays small enough to inline
+/// into the integrators' loops (the epsilon branch is a few instructions).
+#[inline(never)]
+fn error_bound_origin(s: &Surface, side: Vec3) -> Vec3 {
+    offset_ray_origin(s.p, s.p_error, s.ng, side)
 }
 
 /// The shadow ray from `origin` (a [`spawn_origin`] of the shading point `p`) towards the light sample

@@ -33,7 +33,7 @@ use crate::material::{beer, Brdf, BrdfModel, Material};
 use crate::math::{orthonormal_basis, Color, Ray, Vec2, Vec3};
 use crate::renderer::PathOptions;
 use crate::sampler::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, Surface};
 
 /// The longest path Russian roulette may build (a path through glass keeps its throughput).
 pub const MAX_BOUNCES: u32 = 256;
@@ -47,6 +47,15 @@ pub struct PathTracer<'a> {
     /// Probability of choosing each light a ray can meet for a light sample: its share of their total
     /// power; 0 for the others, which are all sampled at every vertex.
     pick: Vec<f32>,
+    /// The lights of probability 0 in `pick`, in scene order: sampled at every vertex.
+    always: Vec<usize>,
+    /// The last light `pick` can choose: it takes what rounding leaves of `u`.
+    last_pick: Option<usize>,
+    /// Whether each light is emissive geometry ([`crate::light::Light::object`]): its shadow rays stop
+    /// short of the surface sampled.
+    on_surface: Vec<bool>,
+    /// The BRDF of each material as the path tracer shades it ([`path_brdf`]).
+    brdfs: Vec<Brdf>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -56,19 +65,24 @@ impl<'a> PathTracer<'a> {
         let powers: Vec<f32> =
             (0..scene.lights.len()).map(|i| if met(i) { scene.lights[i].power().max(0.0) } else { 0.0 }).collect();
         let total: f32 = powers.iter().sum();
-        let pick = if total > 0.0 && total.is_finite() {
+        let pick: Vec<f32> = if total > 0.0 && total.is_finite() {
             powers.iter().map(|p| p / total).collect()
         } else {
             let n = (0..scene.lights.len()).filter(|&i| met(i)).count().max(1) as f32;
             (0..scene.lights.len()).map(|i| if met(i) { 1.0 / n } else { 0.0 }).collect()
         };
-        PathTracer { scene, options, cull_backfaces, camera: None, pick }
+        let always = (0..pick.len()).filter(|&i| pick[i] == 0.0).collect();
+        let last_pick = pick.iter().rposition(|&p| p > 0.0);
+        let on_surface = scene.lights.iter().map(|l| l.object().is_some()).collect();
+        let brdfs = scene.materials.iter().map(path_brdf).collect();
+        PathTracer { scene, options, cull_backfaces, camera: None, pick, always, last_pick, on_surface, brdfs }
     }
 
     /// A light chosen in proportion to its power by `u` in [0, 1), and the probability of that choice.
+    #[inline]
     fn choose_light(&self, u: f32) -> Option<(usize, f32)> {
         let mut rest = u;
-        let last = self.pick.iter().rposition(|&p| p > 0.0)?;
+        let last = self.last_pick?;
         for (i, &p) in self.pick.iter().enumerate() {
             if rest < p || i == last {
                 return Some((i, p));
@@ -139,18 +153,22 @@ impl<'a> PathTracer<'a> {
                 });
                 l += beta * emitted * w;
             }
-            let textured = scene.textured(&ray, &h, &mut s, Default::default());
-            if let Some(c) = textured.and_then(|t| t.replace_all) {
-                l += beta * c;
-                break;
-            }
-            let (kd, ks) = textured.map_or((m.diffuse, m.specular), |t| (t.diffuse, t.specular));
+            let (kd, ks) = if scene.has_textures(s.object) {
+                let Some(t) = scene.textured(&ray, &h, &mut s, Default::default()) else { unreachable!() };
+                if let Some(c) = t.replace_all {
+                    l += beta * c;
+                    break;
+                }
+                (t.diffuse, t.specular)
+            } else {
+                (m.diffuse, m.specular)
+            };
             let d = ray.dir.normalize();
             let wo = -d;
             let front = d.dot(s.ng) < 0.0;
             // Shade the side the ray arrives on.
             let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
-            let brdf = path_brdf(m);
+            let brdf = &self.brdfs[s.material];
             let local = front || !m.transmits();
             // A material may have both a BRDF and a specular layer (a mirror with a diffuse colour): the
             // bounce follows the BRDF with probability `p_brdf`, in proportion to the two parts' weights,
@@ -175,34 +193,22 @@ impl<'a> PathTracer<'a> {
                     }
                 }
             };
+            let at = Vertex { s: &s, ns, wo, kd, ks, brdf, f: brdf.constant(kd, ks), p_brdf, time: ray.time };
 
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
             if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
-                let mut direct = |i: usize, u: Vec2, chosen: f32, log: &mut RayLog| {
-                    let light = &scene.lights[i];
-                    let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
-                    log.rays += 1;
-                    let on_surface = light.object().is_some();
-                    let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, on_surface);
-                    if log.occluded(&scene.geometry, &shadow.with_time(ray.time), t_max) {
-                        return;
-                    }
-                    let w = if o.mis && ls.pdf > 0.0 {
-                        power_heuristic(chosen * ls.pdf, p_brdf * self.bounce_pdf(ns, ls.wi))
-                    } else {
-                        1.0
-                    };
-                    let f = brdf.f(kd, ks, ls.wi, wo, ns) * ns.dot(ls.wi);
-                    l += beta * f * ls.irradiance * (w / chosen);
-                };
                 let (pick, u) = (rng.next_f32(), rng.next_2d());
                 if o.next_event {
-                    for i in (0..scene.lights.len()).filter(|&i| self.pick[i] == 0.0) {
-                        direct(i, rng.next_2d(), 1.0, log);
+                    for &i in &self.always {
+                        if let Some(c) = self.direct(&at, beta, origin, i, rng.next_2d(), 1.0, log) {
+                            l += c;
+                        }
                     }
                     if let Some((i, chosen)) = self.choose_light(pick) {
-                        direct(i, u, chosen, log);
+                        if let Some(c) = self.direct(&at, beta, origin, i, u, chosen, log) {
+                            l += c;
+                        }
                     }
                 }
             }
@@ -242,7 +248,7 @@ impl<'a> PathTracer<'a> {
                 if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
                     break;
                 }
-                beta *= brdf.f(kd, ks, wi, wo, ns) * (cos / pdf);
+                beta *= at.f(wi) * (cos / pdf);
                 if p_brdf < 1.0 {
                     beta /= p_brdf;
                 }
@@ -266,6 +272,39 @@ impl<'a> PathTracer<'a> {
             hit = log.intersect(&scene.geometry, &ray, f32::INFINITY);
         }
         l
+    }
+
+    /// The light `i` brings to the vertex `at` of throughput `beta` through one sample `u` of it, a shadow
+    /// ray from `origin`, when it was chosen with probability `chosen`: `None` when the sample is below
+    /// the surface or blocked.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn direct(
+        &self,
+        at: &Vertex,
+        beta: Color,
+        origin: Vec3,
+        i: usize,
+        u: Vec2,
+        chosen: f32,
+        log: &mut RayLog,
+    ) -> Option<Color> {
+        let scene = self.scene;
+        let (s, ns) = (at.s, at.ns);
+        let light = &scene.lights[i];
+        let ls = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0)?;
+        log.rays += 1;
+        let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, self.on_surface[i]);
+        if log.occluded(&scene.geometry, &shadow.with_time(at.time), t_max) {
+            return None;
+        }
+        let w = if self.options.mis && ls.pdf > 0.0 {
+            power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
+        } else {
+            1.0
+        };
+        let f = at.f(ls.wi) * ns.dot(ls.wi);
+        Some(beta * f * ls.irradiance * (w / chosen))
     }
 
     /// The density of a bounce direction `wi` about the shading normal `n`.
@@ -293,6 +332,32 @@ impl<'a> PathTracer<'a> {
 /// with its Phong exponent.
 fn path_brdf(m: &Material) -> Brdf {
     m.brdf.unwrap_or(Brdf { model: BrdfModel::ModifiedBlinnPhong { normalized: true }, exponent: m.phong_exponent })
+}
+
+/// What light sampling and the bounce need of a path vertex.
+struct Vertex<'s> {
+    s: &'s Surface,
+    /// The shading normal on the side the ray arrived on.
+    ns: Vec3,
+    wo: Vec3,
+    kd: Color,
+    ks: Color,
+    brdf: &'s Brdf,
+    /// The BRDF's value when it does not depend on the directions ([`Brdf::constant`]).
+    f: Option<Color>,
+    p_brdf: f32,
+    time: f32,
+}
+
+impl Vertex<'_> {
+    /// The BRDF towards `wi`, which must be above the shading normal (`ns · wi > 0`).
+    #[inline]
+    fn f(&self, wi: Vec3) -> Color {
+        match self.f {
+            Some(c) => c,
+            None => self.brdf.f(self.kd, self.ks, wi, self.wo, self.ns),
+        }
+    }
 }
 
 /// Veach's power heuristic (β = 2) for a sample of density `a` against another technique's `b`.

@@ -43,6 +43,8 @@ pub struct EmissiveMesh {
     cdf: Vec<f32>,
     /// Each triangle's world-space corners and unit normal on its emitting side, as a sample reads them.
     tris: Vec<([Vec3; 3], Vec3)>,
+    /// `1 / area`, the density per unit area.
+    area_pdf: f32,
 }
 
 impl std::fmt::Debug for EmissiveMesh {
@@ -65,7 +67,8 @@ impl EmissiveMesh {
         radiance: Color,
         object: u32,
     ) -> Option<Self> {
-        let mut light = EmissiveMesh { radiance, object, shape, transform, cdf: vec![0.0], tris: Vec::new() };
+        let mut light =
+            EmissiveMesh { radiance, object, shape, transform, cdf: vec![0.0], tris: Vec::new(), area_pdf: 0.0 };
         let mut total = 0.0f64;
         for i in 0..light.shape.mesh().len() {
             let [a, b, c] = light.world_triangle(i);
@@ -73,6 +76,7 @@ impl EmissiveMesh {
             light.cdf.push(total as f32);
             light.tris.push(([a, b, c], light.normal([a, b, c])));
         }
+        light.area_pdf = 1.0 / light.area();
         (total > 0.0 && total.is_finite()).then_some(light)
     }
 
@@ -103,7 +107,7 @@ impl EmissiveMesh {
     /// The solid-angle density of the point `q` of a triangle of unit normal `n` seen from `p`, and the
     /// unit direction and distance to it; `None` when `q` faces away or coincides with `p`.
     fn towards(&self, p: Vec3, q: Vec3, n: Vec3) -> Option<(Vec3, f32, f32)> {
-        super::towards_area_point(p, q, n, 1.0 / self.area())
+        super::towards_area_point(p, q, n, self.area_pdf)
     }
 }
 

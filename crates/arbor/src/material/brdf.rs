@@ -100,6 +100,28 @@ impl Brdf {
     }
 }
 
+impl Brdf {
+    /// [`Brdf::f`] for light from above the surface (`n·wi > 0`) when it depends on neither direction
+    /// (a model's diffuse term alone, its specular colour black): the same value `f` gives, computed
+    /// once for all the directions a vertex evaluates. `None` when it depends on them.
+    #[inline]
+    pub fn constant(&self, kd: Color, ks: Color) -> Option<Color> {
+        if ks != Color::ZERO {
+            return None;
+        }
+        match self.model {
+            BrdfModel::OriginalPhong
+            | BrdfModel::ModifiedPhong { normalized: false }
+            | BrdfModel::OriginalBlinnPhong
+            | BrdfModel::ModifiedBlinnPhong { normalized: false } => Some(kd),
+            BrdfModel::ModifiedPhong { normalized: true } | BrdfModel::ModifiedBlinnPhong { normalized: true } => {
+                Some(kd / PI)
+            }
+            BrdfModel::TorranceSparrow { .. } => None,
+        }
+    }
+}
+
 /// `cos^p α`, α the angle between the mirror direction of `wi` and `wo` (0 past 90°).
 #[inline]
 fn phong_lobe(wi: Vec3, wo: Vec3, n: Vec3, p: f32) -> f32 {
@@ -248,6 +270,30 @@ mod tests {
         for model in [BrdfModel::OriginalPhong, BrdfModel::OriginalBlinnPhong] {
             let (a, b) = (f(model, 2.0, 0.0, 1.0, wi, wo), f(model, 2.0, 0.0, 1.0, wo, wi));
             assert!(close(a / b, 0.75_f32.sqrt() / 0.5), "{model:?}: {a} {b}");
+        }
+    }
+
+    #[test]
+    fn brdf_constant_is_f_bit_for_bit_wherever_it_is_given() {
+        let mut rng = Rng::for_sample(1, 3, 5, 7);
+        let ts = BrdfModel::TorranceSparrow { eta: 1.5, k: 0.5, kd_fresnel: true };
+        let models =
+            [BrdfModel::OriginalPhong, PHONG, PHONG_NORM, BrdfModel::OriginalBlinnPhong, BLINN, BLINN_NORM, ts];
+        let kd = Color::new(0.3, 0.55, 0.71);
+        for model in models {
+            let b = Brdf { model, exponent: 20.0 };
+            assert_eq!(b.constant(kd, Color::splat(0.2)), None, "{model:?} with a specular colour");
+            let Some(c) = b.constant(kd, Color::ZERO) else {
+                assert_eq!(model, ts);
+                continue;
+            };
+            for _ in 0..100 {
+                let (wi, wo) = (hemisphere(&mut rng), hemisphere(&mut rng));
+                assert_eq!(
+                    c.to_array().map(f32::to_bits),
+                    b.f(kd, Color::ZERO, wi, wo, Vec3::Z).to_array().map(f32::to_bits)
+                );
+            }
         }
     }
 

@@ -118,6 +118,13 @@ impl Scene {
         }
     }
 
+    /// Whether object `object` (scene-file order) has texture maps ([`Scene::textured`] changes its
+    /// shading).
+    #[inline]
+    pub fn has_textures(&self, object: u32) -> bool {
+        self.object_textures.get(object as usize).is_some_and(|t| !t.is_empty())
+    }
+
     /// The index into [`Scene::lights`] of the light that object `object` (scene-file order) is, if it
     /// emits.
     #[inline]
@@ -126,6 +133,7 @@ impl Scene {
     }
 
     /// Shading data for `hit`, found on `ray`.
+    #[inline]
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
         let g = &self.geometry;
         let mut p = ray.at(hit.t);
@@ -300,6 +308,7 @@ fn footprint(width: f32, dir: Vec3, ng: Vec3, at: &TexPoint, to_world: Option<&T
 
 /// Object-space geometric and shading normals of the triangle `hit.sub` of `mesh`: the shading normal
 /// interpolates the vertex normals of smooth meshes.
+#[inline(always)]
 fn triangle_normals(mesh: &TriangleMesh, hit: &Hit) -> (Vec3, Vec3) {
     let i = hit.sub as usize;
     let [a, b, c] = mesh.triangle(i);
