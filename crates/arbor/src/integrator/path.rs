@@ -153,16 +153,14 @@ impl<'a> PathTracer<'a> {
                 });
                 l += beta * emitted * w;
             }
-            let (kd, ks) = if scene.has_textures(s.object) {
-                let Some(t) = scene.textured(&ray, &h, &mut s, Default::default()) else { unreachable!() };
-                if let Some(c) = t.replace_all {
-                    l += beta * c;
-                    break;
-                }
-                (t.diffuse, t.specular)
-            } else {
-                (m.diffuse, m.specular)
-            };
+            // Only textured objects ask for their textures: the common case builds no shading terms.
+            let textured =
+                if scene.has_textures(s.object) { scene.textured(&ray, &h, &mut s, Default::default()) } else { None };
+            if let Some(c) = textured.and_then(|t| t.replace_all) {
+                l += beta * c;
+                break;
+            }
+            let (kd, ks) = textured.map_or((m.diffuse, m.specular), |t| (t.diffuse, t.specular));
             let d = ray.dir.normalize();
             let wo = -d;
             let front = d.dot(s.ng) < 0.0;
