@@ -231,12 +231,7 @@ fn fill(ctx: &Ctx, p: &Plan, at: &Place, out: &mut [MaybeUninit<LeafBlock>]) -> 
     let mut node = Node8::EMPTY;
     let mut lane = 0;
     let mut put = |bounds: Aabb, r: Ref| {
-        for a in 0..3 {
-            node.min[a][lane] = bounds.min[a];
-            node.max[a][lane] = bounds.max[a];
-        }
-        node.child[lane] = r.child;
-        node.count[lane] = r.count;
+        node.set_lane(lane, bounds, r);
         lane += 1;
     };
     let mut next_child = at.first_child;

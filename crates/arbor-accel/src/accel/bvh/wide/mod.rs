@@ -63,6 +63,7 @@ pub(super) use kernel::Kernel;
 use super::Node;
 use crate::accel::Primitives;
 use crate::geometry::Tri4;
+use crate::math::Aabb;
 
 /// Children per wide node.
 pub const WIDTH: usize = 8;
@@ -98,6 +99,17 @@ impl Node8 {
         child: [u32::MAX; WIDTH],
         count: [0; WIDTH],
     };
+
+    /// Sets lane `lane` to the child `r` inside `bounds`.
+    #[inline]
+    fn set_lane(&mut self, lane: usize, bounds: Aabb, r: Ref) {
+        for a in 0..3 {
+            self.min[a][lane] = bounds.min[a];
+            self.max[a][lane] = bounds.max[a];
+        }
+        self.child[lane] = r.child;
+        self.count[lane] = r.count;
+    }
 }
 
 /// A reference to a subtree: an inner node (`count == 0`) or a leaf.

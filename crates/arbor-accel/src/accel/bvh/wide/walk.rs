@@ -111,12 +111,7 @@ impl Collapse<'_> {
         let mut n_inner = 0;
         let mut lane = 0;
         let mut put = |node: &mut Node8, bounds: Aabb, r: Ref| {
-            for a in 0..3 {
-                node.min[a][lane] = bounds.min[a];
-                node.max[a][lane] = bounds.max[a];
-            }
-            node.child[lane] = r.child;
-            node.count[lane] = r.count;
+            node.set_lane(lane, bounds, r);
             lane += 1;
         };
         for (k, &c) in kids[..n].iter().enumerate() {
