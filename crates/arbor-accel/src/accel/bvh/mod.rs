@@ -46,6 +46,7 @@ use std::time::{Duration, Instant};
 
 pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 pub use params::{BvhParams, MedianParams};
+use wide::Kernel;
 pub use wide::{Node8, Wide};
 
 use super::stats::StatsTally;
@@ -59,7 +60,7 @@ pub const LEAF_HARD_MAX: usize = 64;
 /// The node-test kernel the wide BVH's queries run on this processor, detected at run time: `avx2`
 /// (8 lanes at once; the whole query is compiled for AVX2), `sse` (two 4-lane halves) or `scalar`.
 pub fn query_kernel() -> &'static str {
-    wide::Kernel::detect().name()
+    Kernel::detect().name()
 }
 
 /// Every node's depth (root at depth 0) is below this, which sizes the traversal stack. From depth 64
@@ -300,15 +301,23 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn intersect(&self, prims: &P, ray: &Ray, t_max: f32) -> Option<Hit> {
-        wide::intersect::<P, false>(&self.wide, &self.prim_indices, prims, ray, t_max, &mut TraversalCounts::default())
+        wide::intersect_with::<P, false>(
+            Kernel::detect(),
+            &self.wide,
+            &self.prim_indices,
+            prims,
+            ray,
+            t_max,
+            &mut TraversalCounts::default(),
+        )
     }
 
     fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit> {
-        wide::intersect::<P, true>(&self.wide, &self.prim_indices, prims, ray, t_max, counts)
+        wide::intersect_with::<P, true>(Kernel::detect(), &self.wide, &self.prim_indices, prims, ray, t_max, counts)
     }
 
     fn intersect_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]) {
-        wide::intersect_many(&self.wide, &self.prim_indices, prims, rays, t_max, out)
+        wide::intersect_many_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
     }
 
     fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
@@ -330,11 +339,11 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
-        wide::occluded(&self.wide, &self.prim_indices, prims, ray, t_max)
+        wide::occluded_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, ray, t_max)
     }
 
     fn occluded_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
-        wide::occluded_many(&self.wide, &self.prim_indices, prims, rays, t_max, out)
+        wide::occluded_many_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
     }
 
     fn stats(&self) -> AccelStats {

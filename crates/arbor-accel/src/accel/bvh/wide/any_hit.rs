@@ -15,19 +15,8 @@ use crate::accel::closest::trivially_misses;
 use crate::accel::Primitives;
 use crate::math::Ray;
 
-/// Whether anything is hit in `(0, t_max)`.
-#[inline]
-pub(in crate::accel::bvh) fn occluded<P: Primitives + ?Sized>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    ray: &Ray,
-    t_max: f32,
-) -> bool {
-    occluded_with(Kernel::detect(), wide, indices, prims, ray, t_max)
-}
-
-/// [`occluded`] with the given kernel (tests compare the kernels).
+/// Whether anything is hit in `(0, t_max)`, with `kernel`'s node test (the BVH passes the detected
+/// one, tests compare them).
 #[inline]
 pub(in crate::accel::bvh) fn occluded_with<P: Primitives + ?Sized>(
     kernel: Kernel,
@@ -40,20 +29,8 @@ pub(in crate::accel::bvh) fn occluded_with<P: Primitives + ?Sized>(
     run_with(kernel, wide, indices, prims, AnyHit { ray, t_max })
 }
 
-/// Any-hit queries for a batch of rays, `out[i]` for `rays[i]` in `(0, t_max[i])`: the same answers as
-/// [`occluded`] ray by ray.
-pub(in crate::accel::bvh) fn occluded_many<P: Primitives + ?Sized>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    rays: &[Ray],
-    t_max: &[f32],
-    out: &mut [bool],
-) {
-    occluded_many_with(Kernel::detect(), wide, indices, prims, rays, t_max, out)
-}
-
-/// [`occluded_many`] with the given kernel (tests compare the kernels).
+/// Any-hit queries for a batch of rays with `kernel`'s node test, `out[i]` for `rays[i]` in
+/// `(0, t_max[i])`: the same answers as [`occluded_with`] ray by ray.
 pub(in crate::accel::bvh) fn occluded_many_with<P: Primitives + ?Sized>(
     kernel: Kernel,
     wide: &Wide,

@@ -17,20 +17,8 @@ use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
-/// Closest-hit queries for a batch of rays, `out[i]` for `rays[i]` in `(0, t_max[i])`: the same hits as
-/// [`super::intersect`] ray by ray.
-pub(in crate::accel::bvh) fn intersect_many<P: Primitives + ?Sized>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    rays: &[Ray],
-    t_max: &[f32],
-    out: &mut [Option<Hit>],
-) {
-    intersect_many_with(Kernel::detect(), wide, indices, prims, rays, t_max, out)
-}
-
-/// [`intersect_many`] with the given kernel (tests compare the kernels).
+/// Closest-hit queries for a batch of rays with `kernel`'s node test, `out[i]` for `rays[i]` in
+/// `(0, t_max[i])`: the same hits as [`super::intersect_with`] ray by ray.
 pub(in crate::accel::bvh) fn intersect_many_with<P: Primitives + ?Sized>(
     kernel: Kernel,
     wide: &Wide,

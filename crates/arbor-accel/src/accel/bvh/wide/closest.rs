@@ -15,21 +15,9 @@ use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
 use crate::math::Ray;
 
-/// The closest hit in `(0, t_max)`, ties to the lowest primitive index; with `COUNT`, the wide nodes
-/// visited and primitives tested are added to `counts`.
-#[inline]
-pub(in crate::accel::bvh) fn intersect<P: Primitives + ?Sized, const COUNT: bool>(
-    wide: &Wide,
-    indices: &[u32],
-    prims: &P,
-    ray: &Ray,
-    t_max: f32,
-    counts: &mut TraversalCounts,
-) -> Option<Hit> {
-    intersect_with::<P, COUNT>(Kernel::detect(), wide, indices, prims, ray, t_max, counts)
-}
-
-/// [`intersect`] with the given kernel (tests compare the kernels).
+/// The closest hit in `(0, t_max)`, ties to the lowest primitive index, with `kernel`'s node test (the
+/// BVH passes the detected one, tests compare them); with `COUNT`, the wide nodes visited and
+/// primitives tested are added to `counts`.
 #[inline]
 pub(in crate::accel::bvh) fn intersect_with<P: Primitives + ?Sized, const COUNT: bool>(
     kernel: Kernel,

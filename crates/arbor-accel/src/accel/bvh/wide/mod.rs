@@ -42,17 +42,8 @@ mod leaves;
 mod visit;
 mod walk;
 
-pub(super) use any_hit::occluded;
-pub(super) use any_hit::occluded_many;
-#[cfg(test)]
-pub(super) use any_hit::occluded_many_with;
-#[cfg(test)]
-pub(super) use any_hit::occluded_with;
-pub(super) use batch::intersect_many;
-#[cfg(test)]
+pub(super) use any_hit::{occluded_many_with, occluded_with};
 pub(super) use batch::intersect_many_with;
-pub(super) use closest::intersect;
-#[cfg(test)]
 pub(super) use closest::intersect_with;
 #[cfg(test)]
 pub(super) use collapse::PLAN_PARALLEL;
