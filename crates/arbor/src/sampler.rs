@@ -52,17 +52,12 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// The image-plane offset in `[0, 1)²` of sample `k` of `n`: the pixel centre for one sample, otherwise
-/// a jittered point in cell `k` of a `cols x rows` grid (`cols = ceil(sqrt(n))`, `rows = ceil(n / cols)`).
-/// When `n` does not fill that grid (`--spp 10`: 4 x 3 cells for 10 samples), the `rows` rows hold
-/// `n / rows` or one more samples each and are as tall as their share of the samples, so that every cell
-/// still covers `1/n` of the pixel and the estimate stays unbiased. [`Strata`] is the same with the grid
-/// worked out once.
-pub fn pixel_offset(k: u32, n: u32, rng: &mut Rng) -> Vec2 {
-    Strata::new(n).offset(k, rng)
-}
-
-/// The stratification of `n` samples per pixel ([`pixel_offset`]), worked out once per render.
+/// The stratification of `n` samples per pixel, worked out once per render. Sample `k`'s image-plane
+/// offset in `[0, 1)²` ([`Strata::offset`]) is the pixel centre for one sample, otherwise a jittered
+/// point in cell `k` of a `cols x rows` grid (`cols = ceil(sqrt(n))`, `rows = ceil(n / cols)`). When `n`
+/// does not fill that grid (`--spp 10`: 4 x 3 cells for 10 samples), the `rows` rows hold `n / rows` or
+/// one more samples each and are as tall as their share of the samples, so that every cell still covers
+/// `1/n` of the pixel and the estimate stays unbiased.
 #[derive(Debug, Clone, Copy)]
 pub struct Strata {
     n: u32,
@@ -77,7 +72,7 @@ impl Strata {
         Strata { n, cols, rows: n.div_ceil(cols) }
     }
 
-    /// The offset of sample `k` ([`pixel_offset`]).
+    /// The offset of sample `k` (see [`Strata`]).
     #[inline]
     pub fn offset(&self, k: u32, rng: &mut Rng) -> Vec2 {
         let Strata { n, cols, rows } = *self;
@@ -123,9 +118,9 @@ mod tests {
     #[test]
     fn sampler_offsets_cover_their_strata() {
         let mut rng = Rng::for_sample(0, 0, 0, 0);
-        assert_eq!(pixel_offset(0, 1, &mut rng), Vec2::splat(0.5));
+        assert_eq!(Strata::new(1).offset(0, &mut rng), Vec2::splat(0.5));
         for k in 0..16 {
-            let o = pixel_offset(k, 16, &mut rng);
+            let o = Strata::new(16).offset(k, &mut rng);
             let cell = (o * 4.0).floor();
             assert_eq!(cell, Vec2::new((k % 4) as f32, (k / 4) as f32));
         }
@@ -140,7 +135,7 @@ mod tests {
         for &(y0, y1, len) in &rows {
             for c in 0..len {
                 for _ in 0..50 {
-                    let o = pixel_offset(k, 10, &mut rng);
+                    let o = Strata::new(10).offset(k, &mut rng);
                     let (x0, x1) = (c as f32 / len as f32, (c + 1) as f32 / len as f32);
                     assert!(o.x >= x0 && o.x <= x1 && o.y >= y0 - 1e-6 && o.y <= y1 + 1e-6, "{k}: {o}");
                 }
@@ -153,7 +148,7 @@ mod tests {
             let mut sum = Vec2::ZERO;
             for _ in 0..200 {
                 for k in 0..n {
-                    let o = pixel_offset(k, n, &mut rng);
+                    let o = Strata::new(n).offset(k, &mut rng);
                     assert!(o.min_element() >= 0.0 && o.max_element() <= 1.0, "{k} of {n}: {o}");
                     sum += o;
                 }
@@ -163,7 +158,7 @@ mod tests {
         }
         // Full grids that are not square keep their rectangular cells: 6 = 3 x 2.
         for k in 0..6 {
-            let o = pixel_offset(k, 6, &mut rng);
+            let o = Strata::new(6).offset(k, &mut rng);
             assert_eq!((o * Vec2::new(3.0, 2.0)).floor(), Vec2::new((k % 3) as f32, (k / 3) as f32));
         }
     }
