@@ -66,18 +66,16 @@ impl Brdf {
         if cos_i <= 0.0 {
             return Color::ZERO;
         }
-        let p = self.exponent;
         // A material without a specular colour skips its lobe's power (most of a diffuse surface's
         // cost); the diffuse term is the same either way.
-        let ks_zero = ks == Color::ZERO;
+        self.constant(kd, ks).unwrap_or_else(|| self.formula(kd, ks, wi, wo, n, cos_i))
+    }
+
+    /// [`Brdf::f`] by the model's formula, its specular lobe included even when `ks` is black, for
+    /// `cos_i = n·wi > 0`.
+    fn formula(&self, kd: Color, ks: Color, wi: Vec3, wo: Vec3, n: Vec3, cos_i: f32) -> Color {
+        let p = self.exponent;
         match self.model {
-            BrdfModel::OriginalPhong | BrdfModel::ModifiedPhong { normalized: false } if ks_zero => kd,
-            BrdfModel::OriginalBlinnPhong | BrdfModel::ModifiedBlinnPhong { normalized: false } if ks_zero => kd,
-            BrdfModel::ModifiedPhong { normalized: true } | BrdfModel::ModifiedBlinnPhong { normalized: true }
-                if ks_zero =>
-            {
-                kd / PI
-            }
             BrdfModel::OriginalPhong => kd + ks * (phong_lobe(wi, wo, n, p) / cos_i),
             BrdfModel::ModifiedPhong { normalized: false } => kd + ks * phong_lobe(wi, wo, n, p),
             BrdfModel::ModifiedPhong { normalized: true } => {
@@ -293,6 +291,9 @@ mod tests {
                     c.to_array().map(f32::to_bits),
                     b.f(kd, Color::ZERO, wi, wo, Vec3::Z).to_array().map(f32::to_bits)
                 );
+                // `f` answers by `constant` there: the model's own formula must give the same bits.
+                let formula = b.formula(kd, Color::ZERO, wi, wo, Vec3::Z, wi.z);
+                assert_eq!(c.to_array().map(f32::to_bits), formula.to_array().map(f32::to_bits), "{model:?}");
             }
         }
     }
