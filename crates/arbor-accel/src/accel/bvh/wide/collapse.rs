@@ -35,12 +35,12 @@ pub(in crate::accel::bvh) const PLAN_PARALLEL: usize = 1 << 12;
 
 /// One wide node, as planned.
 #[derive(Debug, Clone, Copy)]
-struct Plan {
+pub(super) struct Plan {
     /// The binary nodes that become its children, in lane order (a split leaf takes several lanes).
-    kids: [u32; WIDTH],
-    n: u8,
+    pub(super) kids: [u32; WIDTH],
+    pub(super) n: u8,
     /// Bit `k`: child `k` is a leaf whose blocks each get a lane of their own.
-    split: u8,
+    pub(super) split: u8,
     /// Children that are inner nodes.
     inner: u8,
     /// Blocks of its leaf children (0 unless the primitives are a mesh).
@@ -154,7 +154,7 @@ fn subtree_len(bin: &[Node], i: usize) -> usize {
 /// lanes left over go to the blocks of leaves of more than one block, largest leaves first: a lane
 /// costs nothing in the node test, and a block behind its own box is tested only by rays that meet
 /// that box.
-fn plan_node(bin: &[Node], mesh: bool, i: usize) -> Plan {
+pub(super) fn plan_node(bin: &[Node], mesh: bool, i: usize) -> Plan {
     let area = |c: u32| bin[c as usize].bounds().area_f64();
     let mut kids = [0u32; WIDTH];
     let mut areas = [0.0f64; WIDTH];
@@ -272,7 +272,7 @@ fn fill(ctx: &Ctx, p: &Plan, at: &Place, out: &mut [MaybeUninit<LeafBlock>]) -> 
 /// The triangles `ids` of leaf `b` sorted along its box's longest axis, to be cut in blocks of four:
 /// each block is then a compact piece of the leaf (a ray that meets the leaf's box often meets only
 /// one of them).
-fn sort_leaf(b: &Node, ids: &[u32], mesh: &TriangleMesh) -> [u32; LEAF_HARD_MAX] {
+pub(super) fn sort_leaf(b: &Node, ids: &[u32], mesh: &TriangleMesh) -> [u32; LEAF_HARD_MAX] {
     let axis = b.bounds().longest_axis();
     let key = |i: u32| {
         let [p0, p1, p2] = mesh.triangle(i as usize);
@@ -286,7 +286,7 @@ fn sort_leaf(b: &Node, ids: &[u32], mesh: &TriangleMesh) -> [u32; LEAF_HARD_MAX]
 
 /// The block of triangles `ids` (one to four). Lanes past the last triangle repeat it (the traversal
 /// never tests them).
-fn make_block(mesh: &TriangleMesh, ids: &[u32]) -> LeafBlock {
+pub(super) fn make_block(mesh: &TriangleMesh, ids: &[u32]) -> LeafBlock {
     let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
     let tris = prim.map(|i| mesh.triangle(i as usize));
     LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim }

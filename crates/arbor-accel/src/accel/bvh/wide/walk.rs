@@ -5,9 +5,10 @@
 //! thread-count test compares the two); on one thread the walk is the cheaper of the two, reading the
 //! binary tree once and copying nothing.
 
+use super::collapse::{make_block, plan_node, sort_leaf};
 use super::{advise_huge_pages, LeafBlock, Node8, Ref, WIDTH};
 use crate::accel::bvh::Node;
-use crate::geometry::{Tri4, TriangleMesh};
+use crate::geometry::TriangleMesh;
 use crate::math::Aabb;
 
 /// The wide nodes and the blocks of `bin`, whose root is an inner node.
@@ -36,76 +37,43 @@ struct Collapse<'a> {
     blocks: Vec<LeafBlock>,
 }
 
-impl Collapse<'_> {
+impl<'a> Collapse<'a> {
+    /// The triangle indices of binary leaf `b`.
+    fn ids(&self, b: &Node) -> &'a [u32] {
+        &self.indices[b.offset as usize..b.offset as usize + b.count as usize]
+    }
+
     /// The reference to binary leaf `b`, copying its triangles into blocks for a mesh.
     fn leaf(&mut self, b: &Node) -> Ref {
         let count = b.count as u32;
         let Some(mesh) = self.mesh else { return Ref { child: b.offset, count } };
         let first = self.blocks.len() as u32;
-        let range = b.offset as usize..b.offset as usize + b.count as usize;
-        for ids in self.indices[range].chunks(4) {
-            push_block(&mut self.blocks, mesh, ids);
+        for ids in self.ids(b).chunks(4) {
+            self.blocks.push(make_block(mesh, ids));
         }
         Ref { child: first, count }
     }
 
     /// Binary leaf `b` of a mesh as one reference per block of four triangles, each with the box of its
-    /// own triangles: the leaf's triangles sorted along its box's longest axis, then cut into blocks,
-    /// so that each block is a compact piece of the leaf (a ray that meets the leaf's box often meets
-    /// only one of them).
+    /// own triangles ([`sort_leaf`] orders them).
     fn split_leaf(&mut self, b: &Node, mesh: &TriangleMesh) -> Vec<(Aabb, Ref)> {
-        let axis = b.bounds().longest_axis();
-        let mut ids: Vec<u32> = self.indices[b.offset as usize..b.offset as usize + b.count as usize].to_vec();
-        let key = |i: u32| {
-            let [p0, p1, p2] = mesh.triangle(i as usize);
-            p0[axis] + p1[axis] + p2[axis]
-        };
-        ids.sort_by(|&x, &y| key(x).total_cmp(&key(y)).then(x.cmp(&y)));
-        ids.chunks(4)
-            .map(|chunk| {
-                let bounds = Aabb::from_points(chunk.iter().flat_map(|&i| mesh.triangle(i as usize)));
-                (bounds, Ref { child: push_block(&mut self.blocks, mesh, chunk), count: chunk.len() as u32 })
-            })
-            .collect()
+        let ids = self.ids(b);
+        let sorted = sort_leaf(b, ids, mesh);
+        let mut out = Vec::with_capacity(ids.len().div_ceil(4));
+        for chunk in sorted[..ids.len()].chunks(4) {
+            let bounds = Aabb::from_points(chunk.iter().flat_map(|&i| mesh.triangle(i as usize)));
+            self.blocks.push(make_block(mesh, chunk));
+            out.push((bounds, Ref { child: self.blocks.len() as u32 - 1, count: chunk.len() as u32 }));
+        }
+        out
     }
 
     /// Writes the wide node for binary inner node `i` at `index` (already reserved), then its subtree.
-    /// The inner children of a node get consecutive slots, as in Embree: a ray that enters several of
-    /// them reads neighbouring memory.
+    /// Its children are [`plan_node`]'s; the inner ones get consecutive slots, as in Embree: a ray
+    /// that enters several of them reads neighbouring memory.
     fn node(&mut self, index: usize, i: usize) {
         let bin = self.bin;
-        let mut kids = [0usize; WIDTH];
-        kids[0] = i + 1;
-        kids[1] = bin[i].offset as usize;
-        let mut n = 2;
-        while n < WIDTH {
-            // Open the inner child most likely to be visited.
-            let best = (0..n).filter(|&k| !bin[kids[k]].is_leaf()).max_by(|&a, &b| {
-                let (sa, sb) = (bin[kids[a]].bounds().area_f64(), bin[kids[b]].bounds().area_f64());
-                sa.total_cmp(&sb)
-            });
-            let Some(k) = best else { break };
-            let open = kids[k];
-            kids[k] = open + 1;
-            kids[n] = bin[open].offset as usize;
-            n += 1;
-        }
-        // Lanes left over go to the blocks of leaves of more than one block, largest leaves first:
-        // a lane costs nothing in the node test, and a block behind its own box is tested only by
-        // rays that meet that box.
-        let mut split = [false; WIDTH];
-        if self.mesh.is_some() {
-            let mut free = WIDTH - n;
-            let mut leaves: Vec<usize> = (0..n).filter(|&k| bin[kids[k]].count > 4).collect();
-            leaves.sort_by(|&a, &b| bin[kids[b]].bounds().area_f64().total_cmp(&bin[kids[a]].bounds().area_f64()));
-            for k in leaves {
-                let extra = (bin[kids[k]].count as usize).div_ceil(4) - 1;
-                if extra <= free {
-                    free -= extra;
-                    split[k] = true;
-                }
-            }
-        }
+        let plan = plan_node(bin, self.mesh.is_some(), i);
         let mut node = Node8::EMPTY;
         let mut inner = [(0usize, 0usize); WIDTH];
         let mut n_inner = 0;
@@ -114,9 +82,9 @@ impl Collapse<'_> {
             node.set_lane(lane, bounds, r);
             lane += 1;
         };
-        for (k, &c) in kids[..n].iter().enumerate() {
-            let b = &bin[c];
-            if split[k] {
+        for (k, &c) in plan.kids[..plan.n as usize].iter().enumerate() {
+            let (c, b) = (c as usize, &bin[c as usize]);
+            if plan.split & (1 << k) != 0 {
                 let mesh = self.mesh.expect("only mesh leaves are split");
                 for (bounds, r) in self.split_leaf(b, mesh) {
                     put(&mut node, bounds, r);
@@ -139,13 +107,4 @@ impl Collapse<'_> {
             self.node(slot, c);
         }
     }
-}
-
-/// Appends the block of triangles `ids` (one to four) to `blocks`; returns its index. Lanes past the
-/// last triangle repeat it (the traversal never tests them).
-fn push_block(blocks: &mut Vec<LeafBlock>, mesh: &TriangleMesh, ids: &[u32]) -> u32 {
-    let prim: [u32; 4] = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
-    let tris = prim.map(|i| mesh.triangle(i as usize));
-    blocks.push(LeafBlock { tris: Tri4::new(&tris[..ids.len()]), prim });
-    blocks.len() as u32 - 1
 }
