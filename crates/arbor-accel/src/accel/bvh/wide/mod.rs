@@ -34,6 +34,7 @@
 mod any_hit;
 mod batch;
 mod check;
+mod choose;
 mod closest;
 mod collapse;
 mod dispatch;

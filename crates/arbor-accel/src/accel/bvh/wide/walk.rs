@@ -5,7 +5,7 @@
 //! thread-count test compares the two); on one thread the walk is the cheaper of the two, reading the
 //! binary tree once and copying nothing.
 
-use super::collapse::{make_block, plan_node, sort_leaf};
+use super::choose::{make_block, plan_node, sort_leaf};
 use super::{advise_huge_pages, LeafBlock, Node8, Ref, WIDTH};
 use crate::accel::bvh::Node;
 use crate::geometry::TriangleMesh;
