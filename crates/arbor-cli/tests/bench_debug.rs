@@ -52,7 +52,7 @@ fn bench_json_is_valid_and_complete() {
     }
     assert!(rows[1]["primary"]["speedup"].as_f64().unwrap() > 1.0, "{}", rows[1]);
     assert_eq!(doc["rays"]["primary"]["rays"], 1200);
-    assert!(["avx2", "sse", "scalar"].contains(&doc["kernel"].as_str().unwrap()), "{}", doc["kernel"]);
+    assert!(["avx512", "avx2", "sse", "scalar"].contains(&doc["kernel"].as_str().unwrap()), "{}", doc["kernel"]);
 }
 
 #[test]
@@ -139,7 +139,7 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
         assert_eq!(fields[5], "hits=2", "{line}");
         assert!(line.contains("mismatch=0.333333"), "{line}");
         let kernel = line.split_whitespace().find_map(|f| f.strip_prefix("kernel=")).unwrap_or("");
-        assert!(["avx2", "sse", "scalar"].contains(&kernel), "{line}");
+        assert!(["avx512", "avx2", "sse", "scalar"].contains(&kernel), "{line}");
     }
 
     // --query any times the any-hit query: blocked or not, judged against whether the reference hit.

@@ -250,10 +250,11 @@ pub(super) fn cpu_features() -> String {
     {
         let yes = |b: bool| if b { "yes" } else { "no" };
         format!(
-            "avx2={} fma={} avx512f={}",
+            "avx2={} fma={} avx512f={} avx512vl={}",
             yes(std::is_x86_feature_detected!("avx2")),
             yes(std::is_x86_feature_detected!("fma")),
-            yes(std::is_x86_feature_detected!("avx512f"))
+            yes(std::is_x86_feature_detected!("avx512f")),
+            yes(std::is_x86_feature_detected!("avx512vl"))
         )
     }
     #[cfg(not(target_arch = "x86_64"))]

@@ -57,8 +57,9 @@ use crate::math::{Aabb, Ray, Vec3};
 /// above it is split in the middle of its index range.
 pub const LEAF_HARD_MAX: usize = 64;
 
-/// The node-test kernel the wide BVH's queries run on this processor, detected at run time: `avx2`
-/// (8 lanes at once; the whole query is compiled for AVX2), `sse` (two 4-lane halves) or `scalar`.
+/// The node-test kernel the wide BVH's queries run on this processor, detected at run time: `avx512`
+/// (8 lanes at once, the whole query compiled for AVX-512 F and VL), `avx2` (8 lanes at once, compiled
+/// for AVX2), `sse` (two 4-lane halves) or `scalar`.
 pub fn query_kernel() -> &'static str {
     Kernel::detect().name()
 }

@@ -427,6 +427,7 @@ fn kernels() -> Vec<super::wide::Kernel> {
     {
         kernels.push(Kernel::Sse);
         kernels.extend(super::wide::Avx2::detect().map(Kernel::Avx2));
+        kernels.extend(super::wide::Avx512::detect().map(Kernel::Avx512));
     }
     kernels
 }
@@ -669,8 +670,19 @@ fn query_kernel_names_the_detected_kernel() {
     assert_eq!(names[0], "scalar");
     #[cfg(all(target_arch = "x86_64", not(miri)))]
     {
-        let expected = if super::wide::Avx2::detect().is_some() { "avx2" } else { "sse" };
+        let avx2 = super::wide::Avx2::detect().is_some();
+        let avx512 = super::wide::Avx512::detect().is_some();
+        let expected = if avx512 {
+            "avx512"
+        } else if avx2 {
+            "avx2"
+        } else {
+            "sse"
+        };
         assert_eq!(super::query_kernel(), expected);
-        assert_eq!(&names[1..], if expected == "avx2" { &["sse", "avx2"][..] } else { &["sse"][..] });
+        let mut runs = vec!["sse"];
+        runs.extend(avx2.then_some("avx2"));
+        runs.extend(avx512.then_some("avx512"));
+        assert_eq!(&names[1..], runs);
     }
 }

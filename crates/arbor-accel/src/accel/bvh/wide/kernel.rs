@@ -7,6 +7,9 @@
 //! - [`Avx2`]: the eight lanes in one register per row. Its value is the proof that the processor runs
 //!   AVX2: the only constructor, [`Avx2::detect`], asks the processor, and every path into AVX2 code
 //!   takes that value, so no safe function can run AVX2 instructions on a processor without them.
+//! - [`Avx512`]: the same arithmetic as [`Avx2`] in the same order, compiled for AVX-512 (F and VL) so
+//!   that the comparison writes a mask register (no movemask) and the ray's broadcasts fold into the
+//!   arithmetic as embedded broadcasts; its token, as [`Avx2`]'s, only [`Avx512::detect`] makes.
 //! - [`Sse`]: two 4-lane halves (SSE2 is part of the x86_64 baseline, so any value will do).
 //! - [`Scalar`]: a loop over the lanes (elsewhere than x86_64, and under Miri).
 //!
@@ -39,6 +42,24 @@ impl Avx2 {
     }
 }
 
+/// Proof that this processor runs AVX-512 F and VL (and so AVX2); only [`Avx512::detect`] makes one.
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Avx512 {
+    _detected: (),
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx512 {
+    /// The token when the processor runs AVX-512 F and VL, else `None`.
+    #[inline]
+    pub fn detect() -> Option<Avx512> {
+        // Miri does not run AVX-512 code: it is left to native tests.
+        (!cfg!(miri) && std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512vl"))
+            .then_some(Avx512 { _detected: () })
+    }
+}
+
 /// The two-halves kernel (SSE2, the x86_64 baseline).
 #[cfg(target_arch = "x86_64")]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +72,9 @@ pub struct Scalar;
 /// The code that tests a node's boxes, as a value: the kernels a query may run on this processor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kernel {
+    /// The AVX2 kernel's arithmetic compiled for AVX-512 F and VL (mask compare, embedded broadcasts).
+    #[cfg(target_arch = "x86_64")]
+    Avx512(Avx512),
     /// One 8-lane AVX2 register per axis and side.
     #[cfg(target_arch = "x86_64")]
     Avx2(Avx2),
@@ -68,6 +92,9 @@ impl Kernel {
     pub fn detect() -> Kernel {
         #[cfg(all(target_arch = "x86_64", not(miri)))]
         {
+            if let Some(avx512) = Avx512::detect() {
+                return Kernel::Avx512(avx512);
+            }
             match Avx2::detect() {
                 Some(avx2) => Kernel::Avx2(avx2),
                 None => Kernel::Sse,
@@ -77,9 +104,11 @@ impl Kernel {
         Kernel::Scalar
     }
 
-    /// The kernel's name, as benchmarks report it: `avx2`, `sse` or `scalar`.
+    /// The kernel's name, as benchmarks report it: `avx512`, `avx2`, `sse` or `scalar`.
     pub fn name(self) -> &'static str {
         match self {
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512(_) => "avx512",
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx2(_) => "avx2",
             #[cfg(target_arch = "x86_64")]
@@ -182,6 +211,52 @@ fn test_avx2(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
         _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
     }
     let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack))) as u32;
+    (mask, near_out, slack_out)
+}
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Avx512 {
+    #[inline(always)]
+    fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+        // SAFETY: `self` exists, so `Avx512::detect` found AVX-512 F and VL on this processor.
+        unsafe { test_avx512(lanes, node, t_far) }
+    }
+}
+
+/// [`test_avx2`]'s operations in its order (so its results bit for bit), the comparison into a mask
+/// register.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl")]
+#[inline]
+fn test_avx512(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
+    use std::arch::x86_64::*;
+    let base = float_view(node).as_ptr();
+    let mut near_out = [0.0f32; WIDTH];
+    let mut slack_out = [0.0f32; WIDTH];
+    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+    let mut near = _mm256_setzero_ps();
+    let mut far = _mm256_set1_ps(t_far);
+    let mut scale = _mm256_setzero_ps();
+    for a in 0..3 {
+        let o = _mm256_set1_ps(lanes.org[a]);
+        let inv = _mm256_set1_ps(lanes.inv[a]);
+        // SAFETY: as in `test_avx2`: eight aligned floats of the 64 of `node`.
+        let (e0, e1) = unsafe { (_mm256_load_ps(base.add(lanes.enter[a])), _mm256_load_ps(base.add(lanes.exit[a]))) };
+        let t0 = _mm256_mul_ps(_mm256_sub_ps(e0, o), inv);
+        let t1 = _mm256_mul_ps(_mm256_sub_ps(e1, o), inv);
+        near = _mm256_max_ps(t0, near);
+        far = _mm256_min_ps(t1, far);
+        if a == lanes.major {
+            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), _mm256_and_ps(t1, abs));
+        }
+    }
+    let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
+    // SAFETY: each store writes eight floats into a local array of eight.
+    unsafe {
+        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
+    }
+    let mask = _mm256_cmp_ps_mask::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack)) as u32;
     (mask, near_out, slack_out)
 }
 

@@ -48,9 +48,9 @@ pub(super) use batch::intersect_many_with;
 pub(super) use closest::intersect_with;
 #[cfg(test)]
 pub(super) use collapse::PLAN_PARALLEL;
-#[cfg(test)]
-pub(super) use kernel::Avx2;
 pub(super) use kernel::Kernel;
+#[cfg(test)]
+pub(super) use kernel::{Avx2, Avx512};
 
 use super::Node;
 use crate::accel::Primitives;
