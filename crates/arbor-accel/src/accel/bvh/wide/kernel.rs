@@ -1,4 +1,4 @@
-//! The node test: one ray against a wide node's eight boxes at once, in three kernels that compute the
+//! The node test: one ray against a wide node's eight boxes at once, in four kernels that compute the
 //! same per-lane arithmetic (so they visit the same nodes; a unit test compares them).
 //!
 //! Hand-written SIMD (`std::arch`) because this test is the hot core of every query: the eight slab

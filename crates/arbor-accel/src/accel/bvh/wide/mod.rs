@@ -1,8 +1,8 @@
 //! The 8-wide form of a binary BVH, which is what queries traverse (Wald, Benthin and Boulos 2008,
 //! "Getting rid of packets"; Embree's BVH8): every binary tree, whatever its builder, is collapsed
 //! into nodes of up to eight children whose boxes are stored as structure-of-arrays `f32` lanes, so
-//! one ray is tested against eight boxes at once (`kernel.rs`: AVX2 when the processor has it,
-//! else two SSE halves). Eight children rather than four: a query visits about half as many nodes, and
+//! one ray is tested against eight boxes at once (`kernel.rs`: AVX-512 or AVX2 when the processor has
+//! it, else two SSE halves). Eight children rather than four: a query visits about half as many nodes, and
 //! node fetches are where incoherent rays spend their time.
 //!
 //! Collapse: starting from a binary node's two children, the inner child with the largest surface area
@@ -26,7 +26,7 @@
 //! triangles; the collapse is linear in the binary tree's size (plus a sort of each split leaf's few
 //! triangles).
 //!
-//! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in three kernels (`kernel.rs`), what a query does at a
+//! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in four kernels (`kernel.rs`), what a query does at a
 //! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
 //! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
 //! (`batch.rs`) and the any-hit query (`any_hit.rs`).
