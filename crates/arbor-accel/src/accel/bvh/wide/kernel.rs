@@ -175,42 +175,57 @@ impl NodeTest for Avx2 {
     }
 }
 
+/// The eight slab tests of [`test_avx2`] and [`test_avx512`], one AVX register per row, written once
+/// and expanded inside each (intrinsics inline only into a function compiled for their features):
+/// evaluates to the entry distances, the exit bound they are compared with (`far + slack`), and both
+/// entry distances and slacks as arrays.
+#[cfg(target_arch = "x86_64")]
+macro_rules! slabs_avx {
+    ($lanes:expr, $node:expr, $t_far:expr) => {{
+        let (lanes, node, t_far): (&Lanes, &Node8, f32) = ($lanes, $node, $t_far);
+        let base = float_view(node).as_ptr();
+        let mut near_out = [0.0f32; WIDTH];
+        let mut slack_out = [0.0f32; WIDTH];
+        let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+        let mut near = _mm256_setzero_ps();
+        let mut far = _mm256_set1_ps(t_far);
+        let mut scale = _mm256_setzero_ps();
+        for a in 0..3 {
+            let o = _mm256_set1_ps(lanes.org[a]);
+            let inv = _mm256_set1_ps(lanes.inv[a]);
+            // SAFETY: `enter` and `exit` are below 48 and multiples of 8 (`Lanes::new`), so each load
+            // reads eight floats of the 64 of `node`, 32-byte aligned as `_mm256_load_ps` requires
+            // (`Node8` is aligned to 64).
+            let e0 = unsafe { _mm256_load_ps(base.add(lanes.enter[a])) };
+            // SAFETY: as above.
+            let e1 = unsafe { _mm256_load_ps(base.add(lanes.exit[a])) };
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(e0, o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(e1, o), inv);
+            // The second operand is returned when either is NaN: the accumulator wins, as in `f32::max`.
+            near = _mm256_max_ps(t0, near);
+            far = _mm256_min_ps(t1, far);
+            if a == lanes.major {
+                scale = _mm256_max_ps(_mm256_and_ps(t0, abs), _mm256_and_ps(t1, abs));
+            }
+        }
+        let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
+        // SAFETY: each store writes eight floats into a local array of eight.
+        unsafe {
+            _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+            _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
+        }
+        (near, _mm256_add_ps(far, slack), near_out, slack_out)
+    }};
+}
+
 /// The eight lanes in one AVX register per row.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
 fn test_avx2(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
     use std::arch::x86_64::*;
-    let base = float_view(node).as_ptr();
-    let mut near_out = [0.0f32; WIDTH];
-    let mut slack_out = [0.0f32; WIDTH];
-    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
-    let mut near = _mm256_setzero_ps();
-    let mut far = _mm256_set1_ps(t_far);
-    let mut scale = _mm256_setzero_ps();
-    for a in 0..3 {
-        let o = _mm256_set1_ps(lanes.org[a]);
-        let inv = _mm256_set1_ps(lanes.inv[a]);
-        // SAFETY: `enter` and `exit` are below 48 and multiples of 8 (`Lanes::new`), so each load reads
-        // eight floats of the 64 of `node`, 32-byte aligned as `_mm256_load_ps` requires (`Node8` is
-        // aligned to 64).
-        let (e0, e1) = unsafe { (_mm256_load_ps(base.add(lanes.enter[a])), _mm256_load_ps(base.add(lanes.exit[a]))) };
-        let t0 = _mm256_mul_ps(_mm256_sub_ps(e0, o), inv);
-        let t1 = _mm256_mul_ps(_mm256_sub_ps(e1, o), inv);
-        // The second operand is returned when either is NaN: the accumulator wins, as in `f32::max`.
-        near = _mm256_max_ps(t0, near);
-        far = _mm256_min_ps(t1, far);
-        if a == lanes.major {
-            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), _mm256_and_ps(t1, abs));
-        }
-    }
-    let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
-    // SAFETY: each store writes eight floats into a local array of eight.
-    unsafe {
-        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
-        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
-    }
-    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack))) as u32;
+    let (near, bound, near_out, slack_out) = slabs_avx!(lanes, node, t_far);
+    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, bound)) as u32;
     (mask, near_out, slack_out)
 }
 
@@ -230,33 +245,8 @@ impl NodeTest for Avx512 {
 #[inline]
 fn test_avx512(lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
     use std::arch::x86_64::*;
-    let base = float_view(node).as_ptr();
-    let mut near_out = [0.0f32; WIDTH];
-    let mut slack_out = [0.0f32; WIDTH];
-    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
-    let mut near = _mm256_setzero_ps();
-    let mut far = _mm256_set1_ps(t_far);
-    let mut scale = _mm256_setzero_ps();
-    for a in 0..3 {
-        let o = _mm256_set1_ps(lanes.org[a]);
-        let inv = _mm256_set1_ps(lanes.inv[a]);
-        // SAFETY: as in `test_avx2`: eight aligned floats of the 64 of `node`.
-        let (e0, e1) = unsafe { (_mm256_load_ps(base.add(lanes.enter[a])), _mm256_load_ps(base.add(lanes.exit[a]))) };
-        let t0 = _mm256_mul_ps(_mm256_sub_ps(e0, o), inv);
-        let t1 = _mm256_mul_ps(_mm256_sub_ps(e1, o), inv);
-        near = _mm256_max_ps(t0, near);
-        far = _mm256_min_ps(t1, far);
-        if a == lanes.major {
-            scale = _mm256_max_ps(_mm256_and_ps(t0, abs), _mm256_and_ps(t1, abs));
-        }
-    }
-    let slack = _mm256_mul_ps(scale, _mm256_set1_ps(BOX_SLACK));
-    // SAFETY: each store writes eight floats into a local array of eight.
-    unsafe {
-        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
-        _mm256_storeu_ps(slack_out.as_mut_ptr(), slack);
-    }
-    let mask = _mm256_cmp_ps_mask::<_CMP_LE_OQ>(near, _mm256_add_ps(far, slack)) as u32;
+    let (near, bound, near_out, slack_out) = slabs_avx!(lanes, node, t_far);
+    let mask = _mm256_cmp_ps_mask::<_CMP_LE_OQ>(near, bound) as u32;
     (mask, near_out, slack_out)
 }
 
