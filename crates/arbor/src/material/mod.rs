@@ -1,4 +1,4 @@
-//! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong`]), or the BRDF
+//! Materials at render time: the Blinn-Phong terms every material has ([`blinn_phong()`]), or the BRDF
 //! model it names instead ([`Brdf`]), and the perfectly specular layer that mirrors, conductors and
 //! dielectrics add ([`SpecularLayer`]), each in the file named after its scene-file `type`, made glossy
 //! by a roughness ([`perturb`]). The scene's build step makes a [`Material`] from each material of the

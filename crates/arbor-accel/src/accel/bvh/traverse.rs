@@ -11,7 +11,7 @@
 //!   corners' distances along the ray's major axis, so its error scales with the largest of them, which
 //!   can be far larger than `t` when the ray starts next to a big triangle. The corners lie in the box,
 //!   so that scale is bounded by the box's own slab distances on the major axis; the exit distance is
-//!   enlarged by [`SLACK`] times the larger of them. Slab rounding (pbrt's `gamma(3)`) is far smaller.
+//!   enlarged by [`SLACK`](crate::accel::BOX_SLACK) times the larger of them. Slab rounding (pbrt's `gamma(3)`) is far smaller.
 //!   This is an argued bound, not a proof (a grazing ray on a sliver has larger barycentric error);
 //!   the conformance suite, slivers included, still passes with 16 times less slack.
 //!   Visiting a box too many costs time, never correctness; missing one could change the closest hit,
@@ -19,7 +19,7 @@
 //! - a ray parallel to a slab with its origin exactly on the slab's plane gives `0 * inf = NaN`; `max`
 //!   and `min` ignore the NaN, which treats the ray as inside that slab, the closed-box answer.
 //!
-//! Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
+//! Cost: at most one push per level, so a stack of [`MAX_DEPTH`](super::MAX_DEPTH) entries suffices.
 //!
 //! Queries run on the 8-wide form of the tree (`wide/`), whose exactness rests on this argument; this
 //! binary traversal serves the tests, which check that both give the same hits.

@@ -91,7 +91,7 @@ pub(super) fn build_sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams) -
 }
 
 /// The SAH builder's view of every primitive that can be hit, in index order, the indices of those that
-/// cannot (as [`split_live`]), and the root's boxes: one call to `bounds` per primitive, on chunks in
+/// cannot (as [`split_live`](super::build::split_live)), and the root's boxes: one call to `bounds` per primitive, on chunks in
 /// parallel, each writing its live primitives at the front of its own part of the final array (so
 /// nothing is copied unless some primitive is dead: the same result for any thread count).
 fn sah_prims<P: Primitives + ?Sized>(prims: &P) -> (Vec<SahPrim>, Vec<u32>, Boxes) {

@@ -1,6 +1,6 @@
 //! The any-hit query (shadow rays) on the 8-wide tree: stops at the first hit, visits children in any
 //! order, so it needs neither entry distances on its stack nor the closest-hit bookkeeping. A batch
-//! ([`occluded_many`]) walks two rays at once as the closest-hit batch does (`batch.rs`), with the
+//! ([`occluded_many_with`]) walks two rays at once as the closest-hit batch does (`batch.rs`), with the
 //! same node visit ([`visit_any`]) and so the same nodes and answer per ray as the single query.
 
 use std::mem::MaybeUninit;

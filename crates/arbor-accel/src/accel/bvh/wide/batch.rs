@@ -1,7 +1,7 @@
 //! Queries for a batch of rays on the 8-wide tree, two rays at once: one step of each in turn
 //! ([`Walker`]). A node visit is a chain of dependent loads and arithmetic that one ray cannot overlap
 //! with its next visit, which depends on it, but the other ray's visit can fill that wait. Closest hits
-//! ([`intersect_many`], whose walk is here) and any hits ([`super::occluded_many`], whose walk is in
+//! ([`intersect_many_with`], whose walk is here) and any hits ([`super::occluded_many_with`], whose walk is in
 //! `any_hit.rs`) share the interleaving ([`many`]). Each walk's node visit and pop are those of its
 //! single query, so each ray visits the same nodes and gets the same answer as it would alone. The
 //! counted query stays one ray at a time.
