@@ -1,7 +1,9 @@
-//! `--integrator` and `--path-options` of `render`: the integrator of every camera, and the path
-//! tracer's options, overriding what the scene names (METU `Renderer`, `RendererParams`).
+//! `--integrator`, `--path-options` and `--sampler` of `render`: the integrator of every camera, and the
+//! path tracer's options, overriding what the scene names (METU `Renderer`, `RendererParams`), and how
+//! its random numbers are spread over a pixel's samples.
 
 use arbor::renderer::{PathOptions, Renderer};
+use arbor::sampler::SamplerKind;
 use clap::Args;
 
 /// The flags.
@@ -16,6 +18,29 @@ pub struct IntegratorArgs {
     /// tracer. Implies --integrator path.
     #[arg(long, value_enum, value_delimiter = ',', value_name = "OPTIONS")]
     pub path_options: Option<Vec<PathOption>>,
+    /// The path tracer's samples: independent (each light and bounce sample at random, the images the
+    /// course's references were matched with), or stratified (each light and bounce sample spread over
+    /// the pixel's samples, in its own random order: less noise for the same samples).
+    #[arg(long, value_enum, default_value_t = SamplerArg::Independent)]
+    pub sampler: SamplerArg,
+}
+
+/// `--sampler`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SamplerArg {
+    /// Only the sample positions in the pixel are stratified.
+    Independent,
+    /// The light and bounce samples are stratified too.
+    Stratified,
+}
+
+impl From<SamplerArg> for SamplerKind {
+    fn from(s: SamplerArg) -> Self {
+        match s {
+            SamplerArg::Independent => SamplerKind::Independent,
+            SamplerArg::Stratified => SamplerKind::Stratified,
+        }
+    }
 }
 
 /// `--integrator`.
@@ -75,7 +100,7 @@ mod tests {
     use super::*;
 
     fn args(integrator: Option<IntegratorArg>, path_options: Option<Vec<PathOption>>) -> IntegratorArgs {
-        IntegratorArgs { integrator, path_options }
+        IntegratorArgs { integrator, path_options, sampler: SamplerArg::Independent }
     }
 
     #[test]

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use arbor::camera::Camera;
 use arbor::renderer::Renderer;
+use arbor::sampler::SamplerKind;
 use clap::Args;
 
 use crate::Failure;
@@ -102,6 +103,7 @@ impl Slice {
 }
 
 /// The identity of a render: the scene's bytes and every command-line choice that changes pixels.
+#[allow(clippy::too_many_arguments)] // every input that changes a slice's pixels, hashed together
 pub fn identity(
     scene: &[u8],
     camera: &str,
@@ -110,10 +112,15 @@ pub fn identity(
     cull: Option<bool>,
     env: Option<&Path>,
     renderer: Option<Renderer>,
+    sampler: SamplerKind,
 ) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let options =
+    let mut options =
         format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}\0renderer={renderer:?}");
+    // Only when not the default, so that the slices of a render without it keep their identity.
+    if sampler != SamplerKind::default() {
+        options += &format!("\0sampler={sampler:?}");
+    }
     for &b in scene.iter().chain(options.as_bytes()) {
         h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
     }
@@ -149,18 +156,19 @@ mod tests {
 
     #[test]
     fn slice_identity_is_ascii_for_any_camera_id() {
-        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, 0, None, None, None).is_ascii());
+        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, 0, None, None, None, SamplerKind::Independent).is_ascii());
     }
 
     #[test]
     fn slice_identity_changes_with_what_changes_pixels() {
-        let a = identity(b"scene", "1", 4, 0, None, None, None);
-        assert_eq!(a, identity(b"scene", "1", 4, 0, None, None, None));
-        assert_ne!(a, identity(b"scene2", "1", 4, 0, None, None, None));
-        assert_ne!(a, identity(b"scene", "2", 4, 0, None, None, None));
-        assert_ne!(a, identity(b"scene", "1", 8, 0, None, None, None));
-        assert_ne!(a, identity(b"scene", "1", 4, 1, None, None, None));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, Some(true), None, None));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, Some(Renderer::Whitted)));
+        let a = identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Independent);
+        assert_eq!(a, identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene2", "1", 4, 0, None, None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "2", 4, 0, None, None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "1", 8, 0, None, None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "1", 4, 1, None, None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "1", 4, 0, Some(true), None, None, SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, Some(Renderer::Whitted), SamplerKind::Independent));
+        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Stratified));
     }
 }

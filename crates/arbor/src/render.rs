@@ -33,7 +33,7 @@ use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
 use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
 use crate::renderer::Renderer;
-use crate::sampler::{Rng, Strata};
+use crate::sampler::{SampleStream, SamplerKind, Strata};
 use crate::scene::Scene;
 
 const TILE: u32 = 16;
@@ -63,6 +63,8 @@ pub struct RenderOptions {
     /// Picks every random choice of the render ([`crate::sampler::Rng::for_sample`]); renders with
     /// different seeds have independent noise.
     pub seed: u64,
+    /// How the path tracer's random numbers are spread over a pixel's samples.
+    pub sampler: SamplerKind,
 }
 
 /// What a render measured.
@@ -247,18 +249,18 @@ fn trace(
                 rngs.clear();
                 for &(x, y) in group {
                     for k in k0..k1 {
-                        let mut rng = Rng::for_sample(x, y, k, opts.seed);
-                        let offset = strata.offset(k, &mut rng);
-                        let mut ray = cam.ray(x, y, offset, rng.next_2d());
+                        let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
+                        let offset = strata.offset(k, &mut sample.rng);
+                        let mut ray = cam.ray(x, y, offset, sample.rng.next_2d());
                         // A time is drawn only when something moves, so still scenes keep their streams.
                         if moving {
-                            ray = ray.with_time(rng.next_f32());
+                            ray = ray.with_time(sample.rng.next_f32());
                         }
                         batch.push(match &debug {
                             Some(_) => ray,
                             None => integrator.camera_ray(&ray),
                         });
-                        rngs.push(rng);
+                        rngs.push(sample);
                     }
                 }
                 if debug.is_none() {

@@ -96,6 +96,106 @@ impl Strata {
     }
 }
 
+/// How a path's random numbers are drawn across a pixel's samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SamplerKind {
+    /// Only the sample positions are stratified ([`Strata`]); every other number is independent.
+    #[default]
+    Independent,
+    /// The path tracer's light and bounce samples are stratified too, each 2D dimension over the
+    /// pixel's samples in its own random order ([`SampleStream::padded_2d`]).
+    Stratified,
+}
+
+/// The random numbers of one pixel sample: its [`Rng`] stream, and with [`SamplerKind::Stratified`] the
+/// padded 2D dimensions (pbrt's stratified sampler, "padding" the dimensions with independent
+/// permutations; Kensler 2013, "Correlated Multi-Jittered Sampling", for the permutation without a
+/// table): the `d`-th 2D value that sample `k` asks for lies in cell `π_d(k)` of the pixel's [`Strata`]
+/// grid, `π_d` a random permutation of the `n` samples chosen by the pixel, the seed and `d`. Over the
+/// pixel's samples every cell of every dimension is used once, so each value is still uniform on its own
+/// and every estimate stays unbiased; only the samples' joint spread changes.
+#[derive(Debug, Clone)]
+pub struct SampleStream {
+    /// The sample's own stream: every number that is not a padded dimension, and the jitter in a cell.
+    pub rng: Rng,
+    padded: Option<Padded>,
+}
+
+#[derive(Debug, Clone)]
+struct Padded {
+    strata: Strata,
+    sample: u32,
+    key: u32,
+    next: u32,
+}
+
+impl SampleStream {
+    /// The numbers of sample `sample` of `strata.n` of pixel `(x, y)` under `seed`.
+    pub fn new(kind: SamplerKind, x: u32, y: u32, sample: u32, seed: u64, strata: Strata) -> Self {
+        let rng = Rng::for_sample(x, y, sample, seed);
+        // One sample has nothing to stratify against (and `Strata` puts it at the cell's centre).
+        let padded = (kind == SamplerKind::Stratified && strata.n > 1).then(|| {
+            let key = mix(mix(((y as u64) << 32) | x as u64) ^ seed.rotate_left(17)) as u32;
+            Padded { strata, sample, key, next: 0 }
+        });
+        SampleStream { rng, padded }
+    }
+
+    /// The sample's next padded 2D dimension (see [`SampleStream`]); with [`SamplerKind::Independent`]
+    /// two numbers of the stream, as [`Rng::next_2d`].
+    #[inline]
+    pub fn padded_2d(&mut self) -> Vec2 {
+        match &mut self.padded {
+            None => self.rng.next_2d(),
+            Some(p) => {
+                let d = p.next;
+                p.next += 1;
+                let cell = permute(p.sample, p.strata.n, p.key ^ (d.wrapping_add(1)).wrapping_mul(0x9e37_79b9));
+                p.strata.offset(cell, &mut self.rng)
+            }
+        }
+    }
+}
+
+/// Element `i` of a random permutation of `0..n` chosen by `key`, without a table (Kensler 2013,
+/// "Correlated Multi-Jittered Sampling", listing 3: a hash that is invertible on the next power of two,
+/// cycle-walked down to `n`, then rotated by the key).
+pub fn permute(mut i: u32, n: u32, key: u32) -> u32 {
+    debug_assert!(i < n);
+    let mut w = n.wrapping_sub(1);
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    loop {
+        i ^= key;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= key >> 16;
+        i ^= (i & w) >> 4;
+        i ^= key >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= key >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | key >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < n {
+            break;
+        }
+    }
+    // Kensler's `(i + p) % l` in 32 bits wraps for keys near 2^32 and is then not one-to-one (the test
+    // below found it); in 64 bits it is a rotation of `0..n`.
+    ((i as u64 + key as u64) % n as u64) as u32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,6 +260,46 @@ mod tests {
         for k in 0..6 {
             let o = Strata::new(6).offset(k, &mut rng);
             assert_eq!((o * Vec2::new(3.0, 2.0)).floor(), Vec2::new((k % 3) as f32, (k / 3) as f32));
+        }
+    }
+
+    #[test]
+    fn sampler_permute_is_a_permutation_for_every_count_and_key() {
+        for n in 1..=70 {
+            for key in [0, 1, 0x9e37_79b9, 0xdead_beef, u32::MAX] {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let p = permute(i, n, key);
+                    assert!(p < n && !seen[p as usize], "n {n} key {key}: {i} -> {p}");
+                    seen[p as usize] = true;
+                }
+            }
+        }
+        // Different keys give different orders.
+        let order = |key| (0..16).map(|i| permute(i, 16, key)).collect::<Vec<_>>();
+        assert_ne!(order(1), order(2));
+    }
+
+    #[test]
+    fn sampler_padded_dimensions_use_every_cell_once_per_pixel() {
+        let strata = Strata::new(16);
+        for d in 0..4 {
+            let mut cells: Vec<u32> = (0..16)
+                .map(|k| {
+                    let mut s = SampleStream::new(SamplerKind::Stratified, 5, 7, k, 3, strata);
+                    let v = (0..=d).map(|_| s.padded_2d()).last().unwrap();
+                    (v.y * 4.0) as u32 * 4 + (v.x * 4.0) as u32
+                })
+                .collect();
+            cells.sort_unstable();
+            assert_eq!(cells, (0..16).collect::<Vec<_>>(), "dimension {d}");
+        }
+        // Independent: the plain stream, number for number; so is one sample per pixel.
+        for (kind, n) in [(SamplerKind::Independent, 16), (SamplerKind::Stratified, 1)] {
+            let mut s = SampleStream::new(kind, 5, 7, 0, 3, Strata::new(n));
+            let mut rng = Rng::for_sample(5, 7, 0, 3);
+            assert_eq!(s.padded_2d(), rng.next_2d());
+            assert_eq!(s.rng.next_f32(), rng.next_f32());
         }
     }
 

@@ -15,7 +15,7 @@ use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::math::{Color, Ray};
 use crate::renderer::Renderer;
-use crate::sampler::Rng;
+use crate::sampler::SampleStream;
 use crate::scene::Scene;
 
 /// The integrator of one camera's image.
@@ -45,10 +45,10 @@ impl<'a> Integrator<'a> {
     }
 
     /// Radiance along the camera ray `ray` (from [`Integrator::camera_ray`]) whose closest hit is `hit`.
-    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, sample: &mut SampleStream, log: &mut RayLog) -> Color {
         match self {
-            Integrator::Whitted(w) => w.li_camera_hit(ray, hit, rng, log),
-            Integrator::Path(p) => p.li_camera_hit(ray, hit, rng, log),
+            Integrator::Whitted(w) => w.li_camera_hit(ray, hit, &mut sample.rng, log),
+            Integrator::Path(p) => p.li_camera_hit(ray, hit, sample, log),
         }
     }
 }

@@ -32,7 +32,7 @@ use crate::camera::Camera;
 use crate::material::{beer, Brdf, BrdfModel, Material};
 use crate::math::{orthonormal_basis, Color, Ray, Vec2, Vec3};
 use crate::renderer::PathOptions;
-use crate::sampler::Rng;
+use crate::sampler::SampleStream;
 use crate::scene::{Scene, Surface};
 
 /// The longest path Russian roulette may build (a path through glass keeps its throughput).
@@ -120,7 +120,7 @@ impl<'a> PathTracer<'a> {
     }
 
     /// Radiance (in the scene's units) along the camera ray `ray`, whose closest hit is `hit`.
-    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
+    pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, sample: &mut SampleStream, log: &mut RayLog) -> Color {
         log.rays += 1;
         let scene = self.scene;
         let o = self.options;
@@ -196,10 +196,10 @@ impl<'a> PathTracer<'a> {
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
             if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
-                let (pick, u) = (rng.next_f32(), rng.next_2d());
+                let (pick, u) = (sample.rng.next_f32(), sample.padded_2d());
                 if o.next_event {
                     for &i in &self.always {
-                        if let Some(c) = self.direct(&at, beta, origin, i, rng.next_2d(), 1.0, log) {
+                        if let Some(c) = self.direct(&at, beta, origin, i, sample.rng.next_2d(), 1.0, log) {
                             l += c;
                         }
                     }
@@ -216,7 +216,7 @@ impl<'a> PathTracer<'a> {
             }
             // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
             // With a layer, one number picks the part and, rescaled, the lobe.
-            let part = if m.layer.is_some() { rng.next_f32() } else { 0.0 };
+            let part = if m.layer.is_some() { sample.rng.next_f32() } else { 0.0 };
             let next = if part >= p_brdf {
                 let total = lobe_total;
                 if total <= 0.0 {
@@ -238,9 +238,9 @@ impl<'a> PathTracer<'a> {
                 lobe.dir
             } else {
                 let (wi, pdf) = if o.importance_sampling {
-                    cosine_hemisphere(ns, rng.next_2d())
+                    cosine_hemisphere(ns, sample.padded_2d())
                 } else {
-                    uniform_hemisphere(ns, rng.next_2d())
+                    uniform_hemisphere(ns, sample.padded_2d())
                 };
                 let cos = ns.dot(wi);
                 if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
@@ -255,7 +255,7 @@ impl<'a> PathTracer<'a> {
             };
             if o.russian_roulette {
                 let q = beta.max_element().min(1.0);
-                if rng.next_f32() >= q {
+                if sample.rng.next_f32() >= q {
                     break;
                 }
                 beta /= q;
@@ -421,7 +421,7 @@ mod tests {
         let cos_pdf = |w: Vec3| w.dot(n).max(0.0) / std::f32::consts::PI;
         let uni_pdf = |w: Vec3| if w.dot(n) > 0.0 { 1.0 / (2.0 * std::f32::consts::PI) } else { 0.0 };
         assert!((integrate(cos_pdf) - 1.0).abs() < 2e-3 && (integrate(uni_pdf) - 1.0).abs() < 2e-3);
-        let mut rng = Rng::for_sample(1, 2, 3, 4);
+        let mut rng = crate::sampler::Rng::for_sample(1, 2, 3, 4);
         let (mut mean_cos_c, mut mean_cos_u) = (0.0, 0.0);
         let k = 20_000;
         for _ in 0..k {
