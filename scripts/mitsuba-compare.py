@@ -31,8 +31,8 @@ Mitsuba counts the camera ray as segment 1, the course's renderers recurse D tim
 hit and connect each hit to a light, and D + 2 is what matches the official hw6 path-traced images.
 Russian roulette is off (rr_depth = max_depth). Mitsuba's sampler is `independent` (its default)
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
-path and lower Mitsuba's noise at 64 spp by about a third, while Arbor stratifies only the pixel
-position. Anything else (a specular lobe, textures, PLY meshes,
+path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default stratifies only the pixel
+position, `--arbor-sampler stratified` its light and bounce samples too. Anything else (a specular lobe, textures, PLY meshes,
 non-uniformly scaled spheres, a lens) is refused with its reason and the scene skipped.
 """
 
@@ -290,7 +290,7 @@ def arbor_missing(arbor, integrator, path_options):
 ARBOR_UNIT = 255.0
 
 
-def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0):
+def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0, sampler=None):
     """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed."""
     stats = Path(str(out) + ".stats.json")
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
@@ -299,6 +299,8 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
         cmd += ["--integrator", integrator]
     if integrator and path_options:
         cmd += ["--path-options", path_options]
+    if sampler:
+        cmd += ["--sampler", sampler]
     run = subprocess.run(cmd, capture_output=True, text=True)
     if run.returncode != 0 or not stats.is_file():
         print(f"  Arbor failed (exit {run.returncode}): {' '.join(cmd)}\n    " +
@@ -385,8 +387,9 @@ def compare_scene(args, spec, arbor_ok):
                  for v in args.variants]
     if arbor_ok:
         out = args.cache / f"{tag}_arbor_run.exr"
-        renderers.append(("Arbor", lambda t: render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options,
-                                                          path, camera_id, args.spp, t, out)))
+        name = "Arbor" if args.arbor_sampler is None else f"Arbor ({args.arbor_sampler})"
+        renderers.append((name, lambda t: render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options,
+                                                       path, camera_id, args.spp, t, out, sampler=args.arbor_sampler)))
     for name, render in renderers:
         for threads in args.threads:
             result = render(threads)
@@ -430,6 +433,8 @@ def main():
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--threads", default="1,2", help="comma-separated thread counts")
     parser.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb", help="Mitsuba variants to time")
+    parser.add_argument("--arbor-sampler", help="Arbor's --sampler for the timed renders (its default when unset); "
+                                                "references use Arbor's default")
     parser.add_argument("--mitsuba-sampler", default="independent",
                         help="Mitsuba's sampler for the timed renders (independent, its default; stratified, "
                              "multijitter and ldsampler stratify every dimension); references use independent")
