@@ -243,10 +243,10 @@ fn trace(
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
             let per_batch = (BATCH / samples).max(1);
-            let (mut batch, mut rngs, mut hits) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut batch, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
             for group in tile.chunks(per_batch) {
                 batch.clear();
-                rngs.clear();
+                streams.clear();
                 for &(x, y) in group {
                     for k in k0..k1 {
                         let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
@@ -260,7 +260,7 @@ fn trace(
                             Some(_) => ray,
                             None => integrator.camera_ray(&ray),
                         });
-                        rngs.push(sample);
+                        streams.push(sample);
                     }
                 }
                 if debug.is_none() {
@@ -275,7 +275,7 @@ fn trace(
                                 log.rays += 1;
                                 d.li_camera(&batch[s])
                             }
-                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut rngs[s], &mut log),
+                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut streams[s], &mut log),
                         });
                     }
                     pixels.push(sum);
