@@ -79,9 +79,7 @@ fn f32_at(b: &[u8], at: usize) -> f32 {
 }
 
 fn whole_records(bytes: &[u8], record: usize, path: &Path) -> Result<usize> {
-    // Not `is_multiple_of`: the workspace supports Rust 1.80.
-    #[allow(clippy::manual_is_multiple_of)]
-    if bytes.len() % record != 0 {
+    if !bytes.len().is_multiple_of(record) {
         let whole = bytes.len() / record * record;
         return Err(Error::input(
             Location::byte(path, whole as u64),
