@@ -237,16 +237,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                     Some(p) => std::fs::read(p).map_err(|e| arbor::Error::io(p, e))?,
                     None => EXAMPLE.as_bytes().to_vec(),
                 };
-                let id = identity(
-                    &scene_bytes,
-                    &cam.id,
-                    spp,
-                    args.seed,
-                    cull,
-                    args.env.as_deref(),
-                    base.renderer,
-                    base.sampler,
-                );
+                let id = identity(&scene_bytes, &cam.id, spp, args.env.as_deref(), &base);
                 let window = arbor::render::crop_window(opts.crop, cam.width, cam.height);
                 crate::memory::reserve_for(cam.width, cam.height, window, true)?;
                 let bar = Progress::new(args.quiet > 0, pixels(opts.crop, cam.width, cam.height), &cam.image_name);

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use arbor::camera::Camera;
-use arbor::renderer::Renderer;
+use arbor::render::RenderOptions;
 use arbor::sampler::SamplerKind;
 use clap::Args;
 
@@ -102,23 +102,15 @@ impl Slice {
     }
 }
 
-/// The identity of a render: the scene's bytes and every command-line choice that changes pixels.
-#[allow(clippy::too_many_arguments)] // every input that changes a slice's pixels, hashed together
-pub fn identity(
-    scene: &[u8],
-    camera: &str,
-    spp: u32,
-    seed: u64,
-    cull: Option<bool>,
-    env: Option<&Path>,
-    renderer: Option<Renderer>,
-    sampler: SamplerKind,
-) -> String {
+/// The identity of a render: the scene's bytes and every command-line choice that changes pixels (of
+/// `opts`, those that every slice of the render shares: not its crop or sample range).
+pub fn identity(scene: &[u8], camera: &str, spp: u32, env: Option<&Path>, opts: &RenderOptions) -> String {
+    let RenderOptions { seed, cull_backfaces: cull, renderer, sampler, .. } = opts;
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut options =
         format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}\0renderer={renderer:?}");
     // Only when not the default, so that the slices of a render without it keep their identity.
-    if sampler != SamplerKind::default() {
+    if *sampler != SamplerKind::default() {
         options += &format!("\0sampler={sampler:?}");
     }
     for &b in scene.iter().chain(options.as_bytes()) {
@@ -131,6 +123,7 @@ pub fn identity(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use arbor::renderer::Renderer;
 
     #[test]
     fn slice_tile_parses() {
@@ -156,19 +149,28 @@ mod tests {
 
     #[test]
     fn slice_identity_is_ascii_for_any_camera_id() {
-        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, 0, None, None, None, SamplerKind::Independent).is_ascii());
+        assert!(identity(b"s", "kamera-\u{e7}-\u{1f4f7}", 1, None, &RenderOptions::default()).is_ascii());
     }
 
     #[test]
     fn slice_identity_changes_with_what_changes_pixels() {
-        let a = identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Independent);
-        assert_eq!(a, identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene2", "1", 4, 0, None, None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "2", 4, 0, None, None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "1", 8, 0, None, None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "1", 4, 1, None, None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, Some(true), None, None, SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, Some(Renderer::Whitted), SamplerKind::Independent));
-        assert_ne!(a, identity(b"scene", "1", 4, 0, None, None, None, SamplerKind::Stratified));
+        let base = RenderOptions::default();
+        let a = identity(b"scene", "1", 4, None, &base);
+        assert_eq!(a, identity(b"scene", "1", 4, None, &base));
+        assert_ne!(a, identity(b"scene2", "1", 4, None, &base));
+        assert_ne!(a, identity(b"scene", "2", 4, None, &base));
+        assert_ne!(a, identity(b"scene", "1", 8, None, &base));
+        assert_ne!(a, identity(b"scene", "1", 4, None, &RenderOptions { seed: 1, ..base.clone() }));
+        assert_ne!(a, identity(b"scene", "1", 4, None, &RenderOptions { cull_backfaces: Some(true), ..base.clone() }));
+        let whitted = RenderOptions { renderer: Some(Renderer::Whitted), ..base.clone() };
+        assert_ne!(a, identity(b"scene", "1", 4, None, &whitted));
+        assert_ne!(
+            a,
+            identity(b"scene", "1", 4, None, &RenderOptions { sampler: SamplerKind::Stratified, ..base.clone() })
+        );
+        assert_ne!(a, identity(b"scene", "1", 4, Some(Path::new("sky.exr")), &base));
+        // What differs between one render's slices does not change it.
+        let slice = RenderOptions { crop: Some((0, 0, 8, 8)), samples: Some((0, 2)), ..base.clone() };
+        assert_eq!(a, identity(b"scene", "1", 4, None, &slice));
     }
 }
