@@ -14,7 +14,7 @@ pub struct Rng {
 impl Rng {
     /// The stream for sample `sample` of pixel `(x, y)` under `seed`.
     pub fn for_sample(x: u32, y: u32, sample: u32, seed: u64) -> Rng {
-        let pixel = ((y as u64) << 32) | x as u64;
+        let pixel = pixel_bits(x, y);
         // `mix(0)` is 0: seed 0 keeps the streams Arbor has always drawn (and the images they made).
         let mut rng = Rng { state: 0, inc: ((mix(pixel) ^ mix(seed)) << 1) | 1 };
         rng.next_u32();
@@ -43,6 +43,11 @@ impl Rng {
     pub fn next_2d(&mut self) -> Vec2 {
         Vec2::new(self.next_f32(), self.next_f32())
     }
+}
+
+/// Pixel `(x, y)` as one 64-bit word, the input of the per-pixel hashes.
+fn pixel_bits(x: u32, y: u32) -> u64 {
+    ((y as u64) << 32) | x as u64
 }
 
 /// SplitMix64's finaliser: spreads neighbouring seeds over the whole state space.
@@ -135,7 +140,7 @@ impl SampleStream {
         let rng = Rng::for_sample(x, y, sample, seed);
         // One sample has nothing to stratify against (and `Strata` puts it at the cell's centre).
         let padded = (kind == SamplerKind::Stratified && strata.n > 1).then(|| {
-            let key = mix(mix(((y as u64) << 32) | x as u64) ^ seed.rotate_left(17)) as u32;
+            let key = mix(mix(pixel_bits(x, y)) ^ seed.rotate_left(17)) as u32;
             Padded { strata, sample, key, next: 0 }
         });
         SampleStream { rng, padded }
