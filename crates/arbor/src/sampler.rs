@@ -167,12 +167,8 @@ impl SampleStream {
 /// cycle-walked down to `n`, then rotated by the key).
 pub fn permute(mut i: u32, n: u32, key: u32) -> u32 {
     debug_assert!(i < n);
-    let mut w = n.wrapping_sub(1);
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
+    // All ones below the next power of two of `n`: the domain the hash is invertible on.
+    let w = u32::MAX.checked_shr(n.wrapping_sub(1).leading_zeros()).unwrap_or(0);
     loop {
         i ^= key;
         i = i.wrapping_mul(0xe170_893d);
@@ -196,9 +192,11 @@ pub fn permute(mut i: u32, n: u32, key: u32) -> u32 {
             break;
         }
     }
-    // Kensler's `(i + p) % l` in 32 bits wraps for keys near 2^32 and is then not one-to-one (the test
-    // below found it); in 64 bits it is a rotation of `0..n`.
-    ((i as u64 + key as u64) % n as u64) as u32
+    // Kensler's rotation `(i + p) % l` with the offset `p` in `0..n` taken from the key by a multiply
+    // and shift (Lemire 2019) and the sum wrapped by one subtraction: no division, and no 32-bit
+    // overflow (his sum wraps for keys near 2^32 and is then not one-to-one).
+    let r = i as u64 + ((key as u64 * n as u64) >> 32);
+    (if r >= n as u64 { r - n as u64 } else { r }) as u32
 }
 
 #[cfg(test)]
@@ -270,7 +268,7 @@ mod tests {
 
     #[test]
     fn sampler_permute_is_a_permutation_for_every_count_and_key() {
-        for n in 1..=70 {
+        for n in (1..=70).chain([1000, 4099]) {
             for key in [0, 1, 0x9e37_79b9, 0xdead_beef, u32::MAX] {
                 let mut seen = vec![false; n as usize];
                 for i in 0..n {
