@@ -53,6 +53,33 @@ impl Ray {
     /// True when origin and direction are finite and the direction is not zero: others hit nothing.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO
+        // Zero times a finite float is zero, times an infinity or a NaN is NaN: one sum, no branch per
+        // component (every query asks this).
+        let zero = self.origin * 0.0 + self.dir * 0.0;
+        zero.x + zero.y + zero.z == 0.0 && self.dir != Vec3::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ray_is_valid_only_when_finite_with_a_direction() {
+        let (o, d) = (Vec3::new(1.0, -2.0, 3.0), Vec3::new(0.0, 0.5, -1.0));
+        assert!(Ray::new(o, d).is_valid());
+        assert!(Ray::new(Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX)).is_valid());
+        assert!(!Ray::new(o, Vec3::ZERO).is_valid());
+        assert!(!Ray::new(o, Vec3::splat(-0.0)).is_valid());
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for axis in 0..3 {
+                let mut v = o.to_array();
+                v[axis] = bad;
+                assert!(!Ray::new(Vec3::from_array(v), d).is_valid(), "origin {v:?}");
+                let mut v = d.to_array();
+                v[axis] = bad;
+                assert!(!Ray::new(o, Vec3::from_array(v)).is_valid(), "direction {v:?}");
+            }
+        }
     }
 }

@@ -13,6 +13,7 @@ use super::visit::STACK;
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::trivially_misses;
 use crate::accel::Primitives;
+use crate::geometry::major_axis;
 use crate::math::Ray;
 
 /// Whether anything is hit in `(0, t_max)`, with `kernel`'s node test (the BVH passes the detected
@@ -94,6 +95,10 @@ fn visit_any<K: NodeTest>(
 /// The any-hit traversal from `root`.
 #[inline(always)]
 fn any_hit<L: Leaves, K: NodeTest>(kernel: K, nodes: &[Node8], leaves: &L, root: Ref, ray: &Ray, t_max: f32) -> bool {
+    if root.count != 0 {
+        // A tree that is one leaf: no box to test, so none of the node test's setup.
+        return leaves.any(root, &mut LeafRay::new(ray, major_axis(ray.dir)), t_max);
+    }
     let (lanes, mut q) = prepare(ray);
     let mut stack = [const { MaybeUninit::<Ref>::uninit() }; STACK];
     let mut sp = 0usize;

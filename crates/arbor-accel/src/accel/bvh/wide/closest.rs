@@ -8,11 +8,12 @@
 
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, NodeTest};
-use super::leaves::{prepare, Leaves};
+use super::leaves::{prepare, LeafRay, Leaves};
 use super::visit::{new_stack, pop, visit};
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::{trivially_misses, ClosestHit};
 use crate::accel::{Hit, Primitives, TraversalCounts};
+use crate::geometry::major_axis;
 use crate::math::Ray;
 
 /// The closest hit in `(0, t_max)`, ties to the lowest primitive index, with `kernel`'s node test (the
@@ -65,8 +66,15 @@ fn query<L: Leaves, K: NodeTest, const COUNT: bool>(
     t_max: f32,
     counts: &mut TraversalCounts,
 ) -> Option<Hit> {
-    let (lanes, mut q) = prepare(ray);
     let mut best = ClosestHit::new(t_max);
+    if root.count != 0 {
+        // A tree that is one leaf (a mesh of a few triangles, a scene's wall): no box to test, so none
+        // of the node test's setup.
+        let mut q = LeafRay::new(ray, major_axis(ray.dir));
+        leaves.closest::<COUNT>(root, &mut q, &mut best, counts);
+        return best.hit();
+    }
+    let (lanes, mut q) = prepare(ray);
     let mut stack = new_stack();
     let mut sp = 0usize;
     let mut cur = root;
