@@ -31,8 +31,8 @@ Mitsuba counts the camera ray as segment 1, the course's renderers recurse D tim
 hit and connect each hit to a light, and D + 2 is what matches the official hw6 path-traced images.
 Russian roulette is off (rr_depth = max_depth). Mitsuba's sampler is `independent` (its default)
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
-path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default stratifies only the pixel
-position, `--arbor-sampler stratified` its light and bounce samples too. Anything else (a specular
+path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default (`stratified`) stratifies
+its light and bounce samples too, `--arbor-sampler independent` only the pixel position. Anything else (a specular
 lobe, textures, PLY meshes, non-uniformly scaled spheres, a lens) is refused with its reason and the
 scene skipped.
 """

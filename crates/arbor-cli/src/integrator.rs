@@ -18,27 +18,27 @@ pub struct IntegratorArgs {
     /// tracer. Implies --integrator path.
     #[arg(long, value_enum, value_delimiter = ',', value_name = "OPTIONS")]
     pub path_options: Option<Vec<PathOption>>,
-    /// The path tracer's samples: independent (each light and bounce sample at random, the images the
-    /// course's references were matched with), or stratified (each light and bounce sample spread over
-    /// the pixel's samples, in its own random order: less noise for the same samples).
-    #[arg(long, value_enum, default_value_t = SamplerArg::Independent)]
+    /// The path tracer's samples: stratified (each light and bounce sample spread over the pixel's
+    /// samples, in its own random order: less noise for the same samples), or independent (each at
+    /// random, as Arbor drew them before). The other integrators are the same with either.
+    #[arg(long, value_enum, default_value_t = SamplerArg::Stratified)]
     pub sampler: SamplerArg,
 }
 
 /// `--sampler`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SamplerArg {
-    /// Only the sample positions in the pixel are stratified.
-    Independent,
     /// The light and bounce samples are stratified too.
     Stratified,
+    /// Only the sample positions in the pixel are stratified.
+    Independent,
 }
 
 impl From<SamplerArg> for SamplerKind {
     fn from(s: SamplerArg) -> Self {
         match s {
-            SamplerArg::Independent => SamplerKind::Independent,
             SamplerArg::Stratified => SamplerKind::Stratified,
+            SamplerArg::Independent => SamplerKind::Independent,
         }
     }
 }

@@ -109,8 +109,9 @@ pub fn identity(scene: &[u8], camera: &str, spp: u32, env: Option<&Path>, opts: 
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut options =
         format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}\0renderer={renderer:?}");
-    // Only when not the default, so that the slices of a render without it keep their identity.
-    if *sampler != SamplerKind::default() {
+    // The independent sampler is hashed as before samplers could be chosen, so that the slices of a
+    // render made then keep their identity; any other is named.
+    if *sampler != SamplerKind::Independent {
         options += &format!("\0sampler={sampler:?}");
     }
     for &b in scene.iter().chain(options.as_bytes()) {
@@ -166,7 +167,7 @@ mod tests {
         assert_ne!(a, identity(b"scene", "1", 4, None, &whitted));
         assert_ne!(
             a,
-            identity(b"scene", "1", 4, None, &RenderOptions { sampler: SamplerKind::Stratified, ..base.clone() })
+            identity(b"scene", "1", 4, None, &RenderOptions { sampler: SamplerKind::Independent, ..base.clone() })
         );
         assert_ne!(a, identity(b"scene", "1", 4, Some(Path::new("sky.exr")), &base));
         // What differs between one render's slices does not change it.

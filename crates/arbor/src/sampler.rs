@@ -104,11 +104,13 @@ impl Strata {
 /// How a path's random numbers are drawn across a pixel's samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SamplerKind {
-    /// Only the sample positions are stratified ([`Strata`]); every other number is independent.
-    #[default]
+    /// Only the sample positions are stratified ([`Strata`]); every other number is independent (the
+    /// path tracer's only sampler before [`SamplerKind::Stratified`]).
     Independent,
     /// The path tracer's light and bounce samples are stratified too, each 2D dimension over the
-    /// pixel's samples in its own random order ([`SampleStream::padded_2d`]).
+    /// pixel's samples in its own random order ([`SampleStream::padded_2d`]). The default: less noise
+    /// for the same samples. The other integrators draw the same numbers with either kind.
+    #[default]
     Stratified,
 }
 
