@@ -53,10 +53,7 @@ impl Ray {
     /// True when origin and direction are finite and the direction is not zero: others hit nothing.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        // Zero times a finite float is zero, times an infinity or a NaN is NaN: one sum, no branch per
-        // component (every query asks this).
-        let zero = self.origin * 0.0 + self.dir * 0.0;
-        zero.x + zero.y + zero.z == 0.0 && self.dir != Vec3::ZERO
+        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO
     }
 }
 
