@@ -139,34 +139,42 @@ fn path_variance_of_a_pixel_mean_falls_as_one_over_the_samples() {
 
 #[test]
 fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
-    // The scene of the test above, with uniform bounces (the dimension the sampler spreads matters most
-    // when it is the only random one of a vertex: the point light needs no sample).
-    let light = r#"<PointLight id="1"><Position>1 3 2</Position><Intensity>10000 10000 10000</Intensity></PointLight>"#;
+    // Two scenes where one kind of sample is the only random number of a vertex: the scene of the test
+    // above with uniform bounces (the point light needs no sample), and a square area light with no
+    // bounce at all (its light samples, drawn at every vertex, are all the noise).
     let floor = r#"<Mesh id="2"><Material>1</Material><Faces>2 4 3  2 5 4</Faces></Mesh>"#;
-    let scene = build(&scene_xml(0.8, light, floor), None);
-    let renderer = Some(Renderer::PathTracing(PathOptions { next_event: true, ..Default::default() }));
-    // Per pixel, the variance of its value over seeds, averaged over the image; and the image's mean.
-    let noise = |sampler: SamplerKind| {
-        let films: Vec<Film> = (1..=8)
-            .map(|seed| {
-                let opts = RenderOptions { renderer, spp: Some(16), seed, sampler, ..Default::default() };
-                render(&scene, 0, &opts, &|_, _| {}).unwrap().0
-            })
-            .collect();
-        let n = films[0].pixels.len();
-        let value = |f: &Film, i: usize| f.pixels[i].x + f.pixels[i].y + f.pixels[i].z;
-        let var = (0..n)
-            .map(|i| {
-                let mu = films.iter().map(|f| value(f, i)).sum::<f32>() / films.len() as f32;
-                films.iter().map(|f| (value(f, i) - mu).powi(2)).sum::<f32>() / (films.len() - 1) as f32
-            })
-            .sum::<f32>()
-            / n as f32;
-        (films.iter().map(mean).sum::<f32>() / films.len() as f32, var)
-    };
-    let (mean_i, var_i) = noise(SamplerKind::Independent);
-    let (mean_s, var_s) = noise(SamplerKind::Stratified);
-    assert!(var_i > 0.0 && mean_i > 0.01, "the image has light and noise: {mean_i} {var_i}");
-    assert!(var_s < 0.8 * var_i, "stratified variance {var_s} against independent {var_i}");
-    assert!((mean_s - mean_i).abs() < 0.02 * mean_i, "means {mean_s} and {mean_i}");
+    let point = r#"<PointLight id="1"><Position>1 3 2</Position><Intensity>10000 10000 10000</Intensity></PointLight>"#;
+    let area = r#"<AreaLight id="1"><Position>1 3 2</Position><Normal>0 -1 0</Normal><Size>2</Size>
+        <Radiance>1000 1000 1000</Radiance></AreaLight>"#;
+    let direct_only = |xml: String| xml.replace("<MaxRecursionDepth>4<", "<MaxRecursionDepth>0<");
+    for (what, xml) in
+        [("bounces", scene_xml(0.8, point, floor)), ("area light", direct_only(scene_xml(0.8, area, floor)))]
+    {
+        let scene = build(&xml, None);
+        let renderer = Some(Renderer::PathTracing(PathOptions { next_event: true, ..Default::default() }));
+        // Per pixel, the variance of its value over seeds, averaged over the image; and the image's mean.
+        let noise = |sampler: SamplerKind| {
+            let films: Vec<Film> = (1..=8)
+                .map(|seed| {
+                    let opts = RenderOptions { renderer, spp: Some(16), seed, sampler, ..Default::default() };
+                    render(&scene, 0, &opts, &|_, _| {}).unwrap().0
+                })
+                .collect();
+            let n = films[0].pixels.len();
+            let value = |f: &Film, i: usize| f.pixels[i].x + f.pixels[i].y + f.pixels[i].z;
+            let var = (0..n)
+                .map(|i| {
+                    let mu = films.iter().map(|f| value(f, i)).sum::<f32>() / films.len() as f32;
+                    films.iter().map(|f| (value(f, i) - mu).powi(2)).sum::<f32>() / (films.len() - 1) as f32
+                })
+                .sum::<f32>()
+                / n as f32;
+            (films.iter().map(mean).sum::<f32>() / films.len() as f32, var)
+        };
+        let (mean_i, var_i) = noise(SamplerKind::Independent);
+        let (mean_s, var_s) = noise(SamplerKind::Stratified);
+        assert!(var_i > 0.0 && mean_i > 0.01, "{what}: the image has light and noise: {mean_i} {var_i}");
+        assert!(var_s < 0.8 * var_i, "{what}: stratified variance {var_s} against independent {var_i}");
+        assert!((mean_s - mean_i).abs() < 0.02 * mean_i, "{what}: means {mean_s} and {mean_i}");
+    }
 }

@@ -199,7 +199,7 @@ impl<'a> PathTracer<'a> {
                 let (pick, u) = (sample.rng.next_f32(), sample.padded_2d());
                 if o.next_event {
                     for &i in &self.always {
-                        if let Some(c) = self.direct(&at, beta, origin, i, sample.rng.next_2d(), 1.0, log) {
+                        if let Some(c) = self.direct(&at, beta, origin, i, sample.padded_2d(), 1.0, log) {
                             l += c;
                         }
                     }
