@@ -47,8 +47,9 @@ pub struct PathTracer<'a> {
     /// Probability of choosing each light a ray can meet for a light sample: its share of their total
     /// power; 0 for the others, which are all sampled at every vertex.
     pick: Vec<f32>,
-    /// The lights of probability 0 in `pick`, in scene order: sampled at every vertex.
-    always: Vec<usize>,
+    /// The lights of probability 0 in `pick`, in scene order: sampled at every vertex; each with
+    /// whether its sample reads its random numbers (not a delta light).
+    always: Vec<(usize, bool)>,
     /// The last light `pick` can choose: it takes what rounding leaves of `u`.
     last_pick: Option<usize>,
     /// Whether each light is emissive geometry ([`crate::light::Light::object`]): its shadow rays stop
@@ -71,7 +72,7 @@ impl<'a> PathTracer<'a> {
             let n = (0..scene.lights.len()).filter(|&i| met(i)).count().max(1) as f32;
             (0..scene.lights.len()).map(|i| if met(i) { 1.0 / n } else { 0.0 }).collect()
         };
-        let always = (0..pick.len()).filter(|&i| pick[i] == 0.0).collect();
+        let always = (0..pick.len()).filter(|&i| pick[i] == 0.0).map(|i| (i, !scene.lights[i].is_delta())).collect();
         let last_pick = pick.iter().rposition(|&p| p > 0.0);
         let on_surface = scene.lights.iter().map(|l| l.object().is_some()).collect();
         let brdfs = scene.materials.iter().map(path_brdf).collect();
@@ -198,8 +199,11 @@ impl<'a> PathTracer<'a> {
                 let origin = spawn_origin(scene.offset, &s, ng);
                 let (pick, u) = (sample.rng.next_f32(), sample.padded_2d());
                 if o.next_event {
-                    for &i in &self.always {
-                        if let Some(c) = self.direct(&at, beta, origin, i, sample.padded_2d(), 1.0, log) {
+                    for &(i, sampled) in &self.always {
+                        // A delta light's numbers are never read: plain ones, not a padded dimension
+                        // (the independent sampler draws the same numbers either way).
+                        let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
+                        if let Some(c) = self.direct(&at, beta, origin, i, u, 1.0, log) {
                             l += c;
                         }
                     }

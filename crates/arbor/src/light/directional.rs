@@ -26,6 +26,10 @@ impl Light for DirectionalLight {
     fn power(&self) -> f32 {
         std::f32::consts::PI * self.scene_radius * self.scene_radius * luminance(self.radiance)
     }
+
+    fn is_delta(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -69,6 +69,11 @@ pub trait Light: fmt::Debug + Send + Sync {
     fn object(&self) -> Option<u32> {
         None
     }
+
+    /// Whether the light is a point or a direction, whose [`Light::sample`] does not read `u`.
+    fn is_delta(&self) -> bool {
+        false
+    }
 }
 
 /// A point `q` of a light's surface, of unit normal `n`, chosen with density `area_pdf` per unit area,
@@ -86,4 +91,31 @@ fn towards_area_point(p: Vec3, q: Vec3, n: Vec3, area_pdf: f32) -> Option<(Vec3,
         return None;
     }
     Some((wi, dist, area_pdf * d2 / cos_l))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn light_is_delta_exactly_when_its_sample_ignores_the_random_numbers() {
+        let p = Vec3::new(0.0, 2.0, 0.0);
+        let lights: Vec<Box<dyn Light>> = vec![
+            Box::new(PointLight { position: Vec3::new(0.0, 5.0, 0.0), intensity: Color::ONE }),
+            Box::new(SpotLight::new(Vec3::new(0.0, 5.0, 0.0), -Vec3::Y, Color::ONE, 90.0, 60.0).unwrap()),
+            Box::new(DirectionalLight { direction: -Vec3::Y, radiance: Color::ONE, scene_radius: 1.0 }),
+            Box::new(AreaLight {
+                position: Vec3::new(0.0, 5.0, 0.0),
+                normal: -Vec3::Y,
+                size: 2.0,
+                radiance: Color::ONE,
+            }),
+        ];
+        for light in &lights {
+            let at = |u: Vec2| light.sample(p, Vec3::Y, u).map(|s| s.wi);
+            let same = at(Vec2::new(0.1, 0.2)) == at(Vec2::new(0.8, 0.7));
+            assert!(at(Vec2::new(0.1, 0.2)).is_some(), "{light:?} lights the point");
+            assert_eq!(light.is_delta(), same, "{light:?}");
+        }
+    }
 }

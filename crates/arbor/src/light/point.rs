@@ -30,6 +30,10 @@ impl Light for PointLight {
     fn power(&self) -> f32 {
         4.0 * std::f32::consts::PI * luminance(self.intensity)
     }
+
+    fn is_delta(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

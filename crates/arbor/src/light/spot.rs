@@ -65,6 +65,10 @@ impl Light for SpotLight {
         let cone = 1.0 - 0.5 * (self.cos_falloff + self.cos_coverage);
         std::f32::consts::TAU * luminance(self.intensity) * cone
     }
+
+    fn is_delta(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]
