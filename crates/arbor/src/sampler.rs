@@ -136,6 +136,18 @@ struct Padded {
     next: u32,
 }
 
+impl Padded {
+    /// The next padded dimension, jittered in its cell by `rng`. Out of line: the path tracer asks at
+    /// several places, and inlined there this body crowds the callers' registers.
+    #[inline(never)]
+    fn next_2d(&mut self, rng: &mut Rng) -> Vec2 {
+        let d = self.next;
+        self.next += 1;
+        let cell = permute(self.sample, self.strata.n, self.key ^ (d.wrapping_add(1)).wrapping_mul(0x9e37_79b9));
+        self.strata.offset(cell, rng)
+    }
+}
+
 impl SampleStream {
     /// The numbers of sample `sample` of `strata.n` of pixel `(x, y)` under `seed`.
     pub fn new(kind: SamplerKind, x: u32, y: u32, sample: u32, seed: u64, strata: Strata) -> Self {
@@ -154,12 +166,7 @@ impl SampleStream {
     pub fn padded_2d(&mut self) -> Vec2 {
         match &mut self.padded {
             None => self.rng.next_2d(),
-            Some(p) => {
-                let d = p.next;
-                p.next += 1;
-                let cell = permute(p.sample, p.strata.n, p.key ^ (d.wrapping_add(1)).wrapping_mul(0x9e37_79b9));
-                p.strata.offset(cell, &mut self.rng)
-            }
+            Some(p) => p.next_2d(&mut self.rng),
         }
     }
 }
