@@ -8,6 +8,8 @@ use arbor::accel::AccelConfig;
 use arbor::farm::{merge, read_partial, tile_window, write_partial, Partial};
 use arbor::film::Film;
 use arbor::render::{render, render_sums, RenderOptions};
+use arbor::renderer::{PathOptions, Renderer};
+use arbor::sampler::SamplerKind;
 use arbor::scene::{parse_desc, Scene};
 use arbor::tonemap::Tonemap;
 
@@ -28,9 +30,20 @@ fn bits(film: &Film) -> Vec<u32> {
 
 /// Renders the slice, writes it as a partial EXR in `dir`, reads it back.
 fn part(scene: &Scene, dir: &Path, tile: Option<(u32, u32)>, samples: (u32, u32)) -> (PathBuf, Partial) {
+    part_with(scene, dir, tile, samples, &RenderOptions::default())
+}
+
+/// [`part`] with the render's other options from `base`.
+fn part_with(
+    scene: &Scene,
+    dir: &Path,
+    tile: Option<(u32, u32)>,
+    samples: (u32, u32),
+    base: &RenderOptions,
+) -> (PathBuf, Partial) {
     let cam = &scene.cameras[0];
     let crop = tile.map(|(i, n)| tile_window(i, n, cam.width, cam.height).unwrap());
-    let opts = RenderOptions { crop, samples: Some(samples), ..Default::default() };
+    let opts = RenderOptions { crop, samples: Some(samples), ..base.clone() };
     let (sums, stats) = render_sums(scene, 0, &opts, &|_, _| {}).unwrap();
     assert_eq!(stats.samples, samples);
     let name = format!("part-{:?}-{}-{}.exr", tile.unwrap_or((0, 1)), samples.0, samples.1);
@@ -59,6 +72,28 @@ fn farm_tiles_and_sample_ranges_merge_to_the_whole() {
             let merged = merge(&parts).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(bits(&merged), bits(&whole), "{n} tiles, samples {ranges:?}");
             assert_eq!(merged.to_rgb8(), whole.to_rgb8());
+        }
+    }
+}
+
+#[test]
+fn farm_path_tracer_sample_ranges_merge_to_the_whole() {
+    // The stratified sampler spreads a pixel's light and bounce samples over all its samples: a slice of
+    // them must draw what the whole render draws for the same samples.
+    let scene = example();
+    let dir = tempfile::tempdir().unwrap();
+    for sampler in [SamplerKind::Stratified, SamplerKind::Independent] {
+        let options = PathOptions { importance_sampling: true, next_event: true, mis: true, ..PathOptions::default() };
+        let renderer = Some(Renderer::PathTracing(options));
+        let base = RenderOptions { renderer, sampler, ..Default::default() };
+        let whole = render(&scene, 0, &base, &|_, _| {}).unwrap().0;
+        for n in [1, 4] {
+            let parts: Vec<_> = (0..n)
+                .flat_map(|i| [(0, 1), (1, 3), (3, 4)].into_iter().map(move |r| (i, r)))
+                .map(|(i, r)| part_with(&scene, dir.path(), Some((i, n)), r, &base))
+                .collect();
+            let merged = merge(&parts).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(bits(&merged), bits(&whole), "{sampler:?}, {n} tiles");
         }
     }
 }
