@@ -32,9 +32,9 @@ hit and connect each hit to a light, and D + 2 is what matches the official hw6 
 Russian roulette is off (rr_depth = max_depth). Mitsuba's sampler is `independent` (its default)
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
 path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default (`stratified`) stratifies
-its light and bounce samples too, `--arbor-sampler independent` only the pixel position. Anything else (a specular
-lobe, textures, PLY meshes, non-uniformly scaled spheres, a lens) is refused with its reason and the
-scene skipped.
+its light and bounce samples too, `--arbor-sampler independent` only the pixel position. Anything else
+(a specular lobe, textures, PLY meshes, non-uniformly scaled spheres, a lens) is refused with its reason
+and the scene skipped.
 """
 
 import argparse

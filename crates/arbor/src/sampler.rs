@@ -107,9 +107,10 @@ pub enum SamplerKind {
     /// Only the sample positions are stratified ([`Strata`]); every other number is independent (the
     /// path tracer's only sampler before [`SamplerKind::Stratified`]).
     Independent,
-    /// The path tracer's light and bounce samples are stratified too, each 2D dimension over the
-    /// pixel's samples in its own random order ([`SampleStream::padded_2d`]). The default: less noise
-    /// for the same samples. The other integrators draw the same numbers with either kind.
+    /// The path tracer's light and bounce samples, and its choice among several lights, are stratified
+    /// too, each dimension over the pixel's samples in its own random order
+    /// ([`SampleStream::padded_2d`], [`SampleStream::padded_1d`]). The default: less noise for the same
+    /// samples. The other integrators draw the same numbers with either kind.
     #[default]
     Stratified,
 }
@@ -141,10 +142,25 @@ impl Padded {
     /// several places, and inlined there this body crowds the callers' registers.
     #[inline(never)]
     fn next_2d(&mut self, rng: &mut Rng) -> Vec2 {
+        let cell = self.next_cell();
+        self.strata.offset(cell, rng)
+    }
+
+    /// The next padded dimension of one number: in `1/n`-wide cell `π_d(k)` of `[0, 1)`.
+    #[inline(never)]
+    fn next_1d(&mut self, rng: &mut Rng) -> f32 {
+        let n = self.strata.n;
+        let x = (self.next_cell() as f32 + rng.next_f32()) / n as f32;
+        // The sum rounds up to `n` for large `n`; the interval stays open.
+        x.min(1.0 - f32::EPSILON / 2.0)
+    }
+
+    /// The cell of this sample in the next dimension, `π_d(k)`.
+    #[inline(always)]
+    fn next_cell(&mut self) -> u32 {
         let d = self.next;
         self.next += 1;
-        let cell = permute(self.sample, self.strata.n, self.key ^ (d.wrapping_add(1)).wrapping_mul(0x9e37_79b9));
-        self.strata.offset(cell, rng)
+        permute(self.sample, self.strata.n, self.key ^ (d.wrapping_add(1)).wrapping_mul(0x9e37_79b9))
     }
 }
 
@@ -167,6 +183,16 @@ impl SampleStream {
         match &mut self.padded {
             None => self.rng.next_2d(),
             Some(p) => p.next_2d(&mut self.rng),
+        }
+    }
+
+    /// The sample's next padded dimension of one number, in `[0, 1)`; with [`SamplerKind::Independent`]
+    /// one number of the stream, as [`Rng::next_f32`].
+    #[inline]
+    pub fn padded_1d(&mut self) -> f32 {
+        match &mut self.padded {
+            None => self.rng.next_f32(),
+            Some(p) => p.next_1d(&mut self.rng),
         }
     }
 }
@@ -306,11 +332,27 @@ mod tests {
             cells.sort_unstable();
             assert_eq!(cells, (0..16).collect::<Vec<_>>(), "dimension {d}");
         }
+        // A dimension of one number: every 1/n of [0, 1) once, as 10 samples of a partial grid ask.
+        let strata = Strata::new(10);
+        for d in 0..3 {
+            let mut cells: Vec<u32> = (0..10)
+                .map(|k| {
+                    let mut s = SampleStream::new(SamplerKind::Stratified, 5, 7, k, 3, strata);
+                    let _ = (0..d).map(|_| s.padded_2d()).count();
+                    let x = s.padded_1d();
+                    assert!((0.0..1.0).contains(&x), "{x}");
+                    (x * 10.0) as u32
+                })
+                .collect();
+            cells.sort_unstable();
+            assert_eq!(cells, (0..10).collect::<Vec<_>>(), "dimension {d}");
+        }
         // Independent: the plain stream, number for number; so is one sample per pixel.
         for (kind, n) in [(SamplerKind::Independent, 16), (SamplerKind::Stratified, 1)] {
             let mut s = SampleStream::new(kind, 5, 7, 0, 3, Strata::new(n));
             let mut rng = Rng::for_sample(5, 7, 0, 3);
             assert_eq!(s.padded_2d(), rng.next_2d());
+            assert_eq!(s.padded_1d(), rng.next_f32());
             assert_eq!(s.rng.next_f32(), rng.next_f32());
         }
     }

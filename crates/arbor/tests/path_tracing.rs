@@ -147,9 +147,18 @@ fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
     let area = r#"<AreaLight id="1"><Position>1 3 2</Position><Normal>0 -1 0</Normal><Size>2</Size>
         <Radiance>1000 1000 1000</Radiance></AreaLight>"#;
     let direct_only = |xml: String| xml.replace("<MaxRecursionDepth>4<", "<MaxRecursionDepth>0<");
-    for (what, xml) in
-        [("bounces", scene_xml(0.8, point, floor)), ("area light", direct_only(scene_xml(0.8, area, floor)))]
-    {
+    // Two emitters of different power, one chosen per vertex: the choice is the noise.
+    let emitters = r#"<LightSphere id="1"><Material>1</Material><Center>6</Center><Radius>0.3</Radius>
+        <Radiance>3000 3000 3000</Radiance></LightSphere><LightSphere id="2"><Material>1</Material>
+        <Center>7</Center><Radius>0.3</Radius><Radiance>1000 1000 1000</Radiance></LightSphere>"#;
+    let two = direct_only(scene_xml(0.8, "", &format!("{floor}{emitters}")))
+        .replace("</VertexData>", " -2.5 1.5 1  2.5 1.5 1</VertexData>");
+    let cases = [
+        ("bounces", scene_xml(0.8, point, floor)),
+        ("area light", direct_only(scene_xml(0.8, area, floor))),
+        ("two emitters", two),
+    ];
+    for (what, xml) in cases {
         let scene = build(&xml, None);
         let renderer = Some(Renderer::PathTracing(PathOptions { next_event: true, ..Default::default() }));
         // Per pixel, the variance of its value over seeds, averaged over the image; and the image's mean.

@@ -52,6 +52,9 @@ pub struct PathTracer<'a> {
     always: Vec<(usize, bool)>,
     /// The last light `pick` can choose: it takes what rounding leaves of `u`.
     last_pick: Option<usize>,
+    /// Whether `pick` has a choice to make (two lights or more): only then is the number that makes it
+    /// a padded dimension.
+    several: bool,
     /// Whether each light is emissive geometry ([`crate::light::Light::object`]): its shadow rays stop
     /// short of the surface sampled.
     on_surface: Vec<bool>,
@@ -74,9 +77,10 @@ impl<'a> PathTracer<'a> {
         };
         let always = (0..pick.len()).filter(|&i| pick[i] == 0.0).map(|i| (i, !scene.lights[i].is_delta())).collect();
         let last_pick = pick.iter().rposition(|&p| p > 0.0);
+        let several = pick.iter().filter(|&&p| p > 0.0).count() > 1;
         let on_surface = scene.lights.iter().map(|l| l.object().is_some()).collect();
         let brdfs = scene.materials.iter().map(path_brdf).collect();
-        PathTracer { scene, options, cull_backfaces, camera: None, pick, always, last_pick, on_surface, brdfs }
+        PathTracer { scene, options, cull_backfaces, camera: None, pick, always, last_pick, several, on_surface, brdfs }
     }
 
     /// A light chosen in proportion to its power by `u` in [0, 1), and the probability of that choice.
@@ -197,7 +201,9 @@ impl<'a> PathTracer<'a> {
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
             if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
-                let (pick, u) = (sample.rng.next_f32(), sample.padded_2d());
+                // One light to choose from needs no spread choice: a plain number, as ever.
+                let pick = if self.several { sample.padded_1d() } else { sample.rng.next_f32() };
+                let u = sample.padded_2d();
                 if o.next_event {
                     for &(i, sampled) in &self.always {
                         // A delta light's numbers are never read: plain ones, not a padded dimension
