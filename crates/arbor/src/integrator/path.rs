@@ -201,7 +201,7 @@ impl<'a> PathTracer<'a> {
             // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
             if has_brdf {
                 let origin = spawn_origin(scene.offset, &s, ng);
-                // One light to choose from needs no spread choice: a plain number, as ever.
+                // With one light or none the choice is fixed: a plain number, no padded dimension spent.
                 let pick = if self.several { sample.padded_1d() } else { sample.rng.next_f32() };
                 let u = sample.padded_2d();
                 if o.next_event {
