@@ -116,12 +116,13 @@ pub enum SamplerKind {
 }
 
 /// The random numbers of one pixel sample: its [`Rng`] stream, and with [`SamplerKind::Stratified`] the
-/// padded 2D dimensions (pbrt's stratified sampler, "padding" the dimensions with independent
+/// padded dimensions (pbrt's stratified sampler, "padding" the dimensions with independent
 /// permutations; Kensler 2013, "Correlated Multi-Jittered Sampling", for the permutation without a
-/// table): the `d`-th 2D value that sample `k` asks for lies in cell `π_d(k)` of the pixel's [`Strata`]
-/// grid, `π_d` a random permutation of the `n` samples chosen by the pixel, the seed and `d`. Over the
-/// pixel's samples every cell of every dimension is used once, so each value is still uniform on its own
-/// and every estimate stays unbiased; only the samples' joint spread changes.
+/// table): the `d`-th value that sample `k` asks for lies in cell `π_d(k)`, of the pixel's [`Strata`]
+/// grid for a 2D value and of `n` equal intervals of `[0, 1)` for one number, `π_d` a random
+/// permutation of the `n` samples chosen by the pixel, the seed and `d`. Over the pixel's samples every
+/// cell of every dimension is used once, so each value is still uniform on its own and every estimate
+/// stays unbiased; only the samples' joint spread changes.
 #[derive(Debug, Clone)]
 pub struct SampleStream {
     /// The sample's own stream: every number that is not a padded dimension, and the jitter in a cell.
