@@ -109,16 +109,22 @@ pub fn identity(scene: &[u8], camera: &str, spp: u32, env: Option<&Path>, opts: 
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut options =
         format!("\0camera={camera}\0spp={spp}\0seed={seed}\0cull={cull:?}\0env={env:?}\0renderer={renderer:?}");
-    // The independent sampler is hashed as before samplers could be chosen, so that the slices of a
-    // render made then keep their identity; any other is named.
-    if *sampler != SamplerKind::Independent {
-        options += &format!("\0sampler={sampler:?}");
+    if let Some(name) = sampler_name(*sampler) {
+        options += &format!("\0sampler={name}");
     }
     for &b in scene.iter().chain(options.as_bytes()) {
         h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
     }
     // Escaped: EXR text attributes hold Latin-1 only, and the identity must survive the trip intact.
     format!("fnv1a64:{h:016x} camera={} spp={spp}", camera.escape_default())
+}
+
+/// How the identity names `sampler` and its stream version. The independent sampler's first streams
+/// are not named, as before samplers could be chosen, so that the slices of a render made then keep
+/// their identity.
+fn sampler_name(sampler: SamplerKind) -> Option<String> {
+    (sampler != SamplerKind::Independent || sampler.stream_version() != 1)
+        .then(|| format!("{sampler:?}/{}", sampler.stream_version()))
 }
 
 #[cfg(test)]
@@ -170,6 +176,9 @@ mod tests {
             identity(b"scene", "1", 4, None, &RenderOptions { sampler: SamplerKind::Independent, ..base.clone() })
         );
         assert_ne!(a, identity(b"scene", "1", 4, Some(Path::new("sky.exr")), &base));
+        // Streams of another version are another render.
+        assert_eq!(sampler_name(SamplerKind::Independent), None);
+        assert_eq!(sampler_name(SamplerKind::Stratified).as_deref(), Some("Stratified/2"));
         // What differs between one render's slices does not change it.
         let slice = RenderOptions { crop: Some((0, 0, 8, 8)), samples: Some((0, 2)), ..base.clone() };
         assert_eq!(a, identity(b"scene", "1", 4, None, &slice));

@@ -115,6 +115,19 @@ pub enum SamplerKind {
     Stratified,
 }
 
+impl SamplerKind {
+    /// The version of the numbers this sampler gives a pixel sample, raised whenever they change: the
+    /// slice identity names it, so that slices of a render made before such a change do not merge with
+    /// slices made after it. `sampler_stream_versions_pin_their_numbers` fails until it is raised.
+    pub fn stream_version(self) -> u32 {
+        match self {
+            SamplerKind::Independent => 1,
+            // 1: the first padded dimensions (2026-11-26); 2: Kensler's rotation without a division.
+            SamplerKind::Stratified => 2,
+        }
+    }
+}
+
 /// The random numbers of one pixel sample: its [`Rng`] stream, and with [`SamplerKind::Stratified`] the
 /// padded dimensions (pbrt's stratified sampler, "padding" the dimensions with independent
 /// permutations; Kensler 2013, "Correlated Multi-Jittered Sampling", for the permutation without a
@@ -356,6 +369,29 @@ mod tests {
             assert_eq!(s.padded_1d(), rng.next_f32());
             assert_eq!(s.rng.next_f32(), rng.next_f32());
         }
+    }
+
+    /// A digest of the numbers of a few samples of one pixel: padded 2D and 1D dimensions and plain
+    /// numbers, in the order a path asks for them.
+    fn stream_digest(kind: SamplerKind) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for k in 0..10 {
+            let mut s = SampleStream::new(kind, 5, 7, k, 3, Strata::new(10));
+            let v = [s.padded_2d(), s.padded_2d()];
+            let bits = [v[0].x, v[0].y, v[1].x, v[1].y, s.padded_1d(), s.rng.next_f32()].map(f32::to_bits);
+            for b in bits {
+                h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn sampler_stream_versions_pin_their_numbers() {
+        // When this fails, the numbers changed: raise the sampler's `stream_version` and pin both anew.
+        let pinned = |kind: SamplerKind| (kind.stream_version(), stream_digest(kind));
+        assert_eq!(pinned(SamplerKind::Independent), (1, 0x1580_e5a0_9ad6_6d52));
+        assert_eq!(pinned(SamplerKind::Stratified), (2, 0x327f_0b08_ca51_edfe));
     }
 
     #[test]
