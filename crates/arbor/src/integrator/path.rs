@@ -165,7 +165,8 @@ impl<'a> PathTracer<'a> {
                 l += beta * c;
                 break;
             }
-            let (kd, ks) = textured.map_or((m.diffuse, m.specular), |t| (t.diffuse, t.specular));
+            let kd = textured.as_ref().map_or(m.diffuse, |t| t.diffuse);
+            let ks = textured.as_ref().map_or(m.specular, |t| t.specular);
             let d = ray.dir.normalize();
             let wo = -d;
             let front = d.dot(s.ng) < 0.0;
@@ -209,14 +210,10 @@ impl<'a> PathTracer<'a> {
                         // A delta light's numbers are never read: plain ones, not a padded dimension
                         // (the independent sampler draws the same numbers either way).
                         let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
-                        if let Some(c) = self.direct(&at, beta, origin, i, u, 1.0, log) {
-                            l += c;
-                        }
+                        self.direct(&at, beta, origin, i, u, 1.0, log, &mut l);
                     }
                     if let Some((i, chosen)) = self.choose_light(pick) {
-                        if let Some(c) = self.direct(&at, beta, origin, i, u, chosen, log) {
-                            l += c;
-                        }
+                        self.direct(&at, beta, origin, i, u, chosen, log, &mut l);
                     }
                 }
             }
@@ -282,9 +279,10 @@ impl<'a> PathTracer<'a> {
         l
     }
 
-    /// The light `i` brings to the vertex `at` of throughput `beta` through one sample `u` of it, a shadow
-    /// ray from `origin`, when it was chosen with probability `chosen`: `None` when the sample is below
-    /// the surface or blocked.
+    /// Adds to `l` the light `i` brings to the vertex `at` of throughput `beta` through one sample `u` of
+    /// it, a shadow ray from `origin`, when it was chosen with probability `chosen`; nothing when the
+    /// sample is below the surface or blocked. Added here rather than returned: an `Option<Color>`
+    /// comes back through memory, and the caller's wider load of it stalled on the narrower stores.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn direct(
@@ -296,15 +294,16 @@ impl<'a> PathTracer<'a> {
         u: Vec2,
         chosen: f32,
         log: &mut RayLog,
-    ) -> Option<Color> {
+        l: &mut Color,
+    ) {
         let scene = self.scene;
         let (s, ns) = (at.s, at.ns);
         let light = &scene.lights[i];
-        let ls = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0)?;
+        let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
         log.rays += 1;
         let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, self.on_surface[i]);
         if log.occluded(&scene.geometry, &shadow.with_time(at.time), t_max) {
-            return None;
+            return;
         }
         let w = if self.options.mis && ls.pdf > 0.0 {
             power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
@@ -312,7 +311,7 @@ impl<'a> PathTracer<'a> {
             1.0
         };
         let f = at.f(ls.wi) * ns.dot(ls.wi);
-        Some(beta * f * ls.irradiance * (w / chosen))
+        *l += beta * f * ls.irradiance * (w / chosen);
     }
 
     /// The density of a bounce direction `wi` about the shading normal `n`.
