@@ -216,6 +216,11 @@ impl SceneGeometry {
         if !ray.is_valid() {
             return None;
         }
+        if self.planes.is_empty() {
+            // The top level's hit returned as it is, not copied: the copy's wide loads of the callee's
+            // narrower stores stalled the path tracer's every bounce.
+            return self.top.intersect(&self.objects, ray, t_max);
+        }
         let best = self.top.intersect(&self.objects, ray, t_max);
         self.intersect_planes(ray, t_max, best, None)
     }
