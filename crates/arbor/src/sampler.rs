@@ -122,7 +122,6 @@ impl SamplerKind {
     pub fn stream_version(self) -> u32 {
         match self {
             SamplerKind::Independent => 1,
-            // 1: the first padded dimensions (2026-11-26); 2: Kensler's rotation without a division.
             SamplerKind::Stratified => 2,
         }
     }

@@ -165,6 +165,8 @@ impl<'a> PathTracer<'a> {
                 l += beta * c;
                 break;
             }
+            // One by one: picked as a pair, the two colours went through memory in pieces of other
+            // sizes than they are read in, and the reads waited for the writes.
             let kd = textured.as_ref().map_or(m.diffuse, |t| t.diffuse);
             let ks = textured.as_ref().map_or(m.specular, |t| t.specular);
             let d = ray.dir.normalize();
