@@ -21,7 +21,7 @@ pub struct DiffArgs {
     #[arg(long, default_value_t = 8)]
     pub threshold: u8,
     /// Fail (exit 1) when more than this percentage of pixels (or blocks) is off.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = parse_percent)]
     pub max_off: f64,
     /// Compare the means of KxK-pixel blocks instead of pixels, for noisy renders (blocks at the right and
     /// bottom edges are averaged over the pixels they have).
@@ -33,6 +33,15 @@ pub struct DiffArgs {
     /// level, with every channel's mean signed difference within 2 levels.
     #[arg(long, num_args = 2, value_names = ["SEED_A", "SEED_B"])]
     pub noise: Option<Vec<PathBuf>>,
+}
+
+/// Parses `--max-off`: a percentage from 0 to 100 (a NaN limit would pass every image).
+fn parse_percent(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(p) if (0.0..=100.0).contains(&p) => Ok(p),
+        Ok(_) => Err(format!("'{s}' is not a percentage from 0 to 100")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
 }
 
 /// Parses `--block`: a whole number of pixels, at least 1.
@@ -101,5 +110,16 @@ mod tests {
         assert_eq!(parse_block("0"), Err("a block is at least 1 pixel wide".into()));
         assert_eq!(parse_block("-2"), Err("'-2' is not a whole number of pixels".into()));
         assert_eq!(parse_block("4x4"), Err("'4x4' is not a whole number of pixels".into()));
+    }
+
+    #[test]
+    fn parse_percent_takes_0_to_100_only() {
+        assert_eq!(parse_percent("0"), Ok(0.0));
+        assert_eq!(parse_percent(" 2.5 "), Ok(2.5));
+        assert_eq!(parse_percent("100"), Ok(100.0));
+        for bad in ["nan", "NaN", "-1", "100.5", "inf"] {
+            assert_eq!(parse_percent(bad), Err(format!("'{bad}' is not a percentage from 0 to 100")));
+        }
+        assert_eq!(parse_percent("half"), Err("'half' is not a number".into()));
     }
 }
