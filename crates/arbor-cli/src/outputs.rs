@@ -8,7 +8,7 @@
 //! created, as their writers create it; `--stats-json` may not) and that accepts a new file (a probe file is created and removed at once, which also answers for root, for
 //! whom permission bits say nothing). Errors name the target file.
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use arbor::image_io::SUPPORTED_WRITE_EXTENSIONS;
 use arbor::scene::CameraDesc;
@@ -44,14 +44,30 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
         check_writable(out, true)?;
         return Ok(vec![out.to_path_buf()]);
     }
-    let mut targets = Vec::with_capacity(cameras.len());
+    let mut targets: Vec<PathBuf> = Vec::with_capacity(cameras.len());
+    // Every file written so far and its camera: the image, and the PNG beside an HDR image.
+    let mut written: Vec<(PathBuf, &str)> = Vec::new();
     for cam in cameras {
-        let path = out.join(&cam.image_name);
-        check_extension(&path).map_err(|msg| {
+        let refuse = |msg: String| {
             let msg = format!("Camera {}: ImageName '{}': {msg}", cam.id, cam.image_name);
             arbor::Error::input(cam.loc.clone(), msg)
-        })?;
+        };
+        // A scene names its images inside the output folder: it may not write elsewhere.
+        if !Path::new(&cam.image_name).components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)) {
+            return Err(refuse("must be a name inside the output folder (no absolute path, no '..')".into()).into());
+        }
+        let path = out.join(&cam.image_name);
+        check_extension(&path).map_err(refuse)?;
+        let preview = arbor::image_io::is_hdr_path(&path).then(|| path.with_extension("png"));
+        for file in std::iter::once(&path).chain(&preview) {
+            if let Some((_, other)) = written.iter().find(|(f, _)| f == file) {
+                let msg = format!("{} would also be written by camera {other}", file.display());
+                return Err(refuse(msg).into());
+            }
+        }
         check_writable(&path, true)?;
+        written.push((path.clone(), &cam.id));
+        written.extend(preview.map(|p| (p, cam.id.as_str())));
         targets.push(path);
     }
     Ok(targets)
@@ -70,6 +86,9 @@ pub fn check_extension(path: &Path) -> Result<(), String> {
 /// the nearest existing one accepts files (the write creates them); without, the folder must exist.
 pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
     let fail = |why: String| Failure::Arbor(arbor::Error::io(path, std::io::Error::other(why)));
+    if path.is_dir() {
+        return Err(fail("cannot write it: it is a folder".into()));
+    }
     let mut dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),

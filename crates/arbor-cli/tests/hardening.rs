@@ -338,6 +338,45 @@ fn hardening_output_paths_are_checked_before_rendering() {
 }
 
 #[test]
+fn hardening_scene_images_stay_in_the_output_folder_and_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let outside = tmp.path().join("abs.png");
+    for name in ["../escape.png", "a/../../escape.png", outside.to_str().unwrap()] {
+        let text = scene(SPHERE, name);
+        std::fs::write(tmp.path().join("up.xml"), &text).unwrap();
+        let o = arbor(&["render", "up.xml", "-o", "out"], tmp.path());
+        let want = format!(
+            "error: up.xml:{}: Camera 1: ImageName '{name}': must be a name inside the output folder (no absolute \
+             path, no '..')\n",
+            position(&text, "<Camera ")
+        );
+        assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
+        assert_eq!(entries(tmp.path()), ["up.xml"], "{name}: wrote something");
+    }
+
+    // Two cameras whose files collide: the second's HDR image brings a PNG of the first's name.
+    let one = scene(SPHERE, "s.png");
+    let second = one.find("</Camera>").map(|i| i + "</Camera>".len()).unwrap();
+    let camera = &one[one.find("<Camera ").unwrap()..second];
+    let camera2 = camera.replace(r#"id="1""#, r#"id="2""#).replace("s.png", "s.exr");
+    let text = format!("{}\n{camera2}{}", &one[..second], &one[second..]);
+    std::fs::write(tmp.path().join("two.xml"), &text).unwrap();
+    let o = arbor(&["render", "two.xml", "-o", "out"], tmp.path());
+    let want = format!(
+        "error: two.xml:{}: Camera 2: ImageName 's.exr': out/s.png would also be written by camera 1\n",
+        position(&text, r#"<Camera id="2""#)
+    );
+    assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
+
+    // A statistics file that is a folder is refused before rendering.
+    std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.png")).unwrap();
+    std::fs::create_dir(tmp.path().join("stats")).unwrap();
+    let o = arbor(&["render", "s.xml", "-o", "out", "--stats-json", "stats"], tmp.path());
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), "error: stats: cannot write it: it is a folder\n"));
+    assert_eq!(entries(tmp.path()), ["s.xml", "stats", "two.xml", "up.xml"]);
+}
+
+#[test]
 fn hardening_short_render_prints_no_progress_to_a_log() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.png")).unwrap();
