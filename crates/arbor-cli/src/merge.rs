@@ -28,6 +28,19 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
     // Checked before the parts are read: they may be many and large.
     crate::outputs::check_extension(&args.out).map_err(Failure::Usage)?;
     crate::outputs::check_writable(&args.out, true)?;
+    // The image, and the PNG beside an HDR one, must not replace a part (they are read first, but a
+    // failed or repeated merge would then have lost it).
+    let preview = arbor::image_io::is_hdr_path(&args.out).then(|| args.out.with_extension("png"));
+    for written in std::iter::once(&args.out).chain(&preview) {
+        if let Some(part) = args.parts.iter().find(|p| same_file(p, written)) {
+            return Err(Failure::Usage(format!(
+                "-o {}: merge would write {}, which is the part {}",
+                args.out.display(),
+                written.display(),
+                part.display()
+            )));
+        }
+    }
     let parts = args
         .parts
         .iter()
@@ -55,4 +68,12 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
         say!("Saved: {}", path.display());
     }
     Ok(())
+}
+
+/// True when `a` and `b` name one existing file.
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }

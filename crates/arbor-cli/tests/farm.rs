@@ -145,6 +145,20 @@ fn farm_cli_refuses_wrong_slices_and_parts() {
     let msg = "error: front0.exr: samples 0..4 of pixel (0, 0) are also in front0.exr\n";
     assert_eq!((code, err.as_str()), (3, msg));
     assert!(!d.join("m.png").exists());
+    // The output may not replace a part, nor may the PNG beside an HDR output.
+    let before = std::fs::read(d.join("front0.exr")).unwrap();
+    let (code, err) = fails(&["merge", "front0.exr", "front1.exr", "-o", "./front0.exr"], d);
+    let msg = "error: -o ./front0.exr: merge would write ./front0.exr, which is the part front0.exr\n";
+    assert_eq!((code, err.as_str()), (2, msg));
+    std::fs::write(d.join("front0.png"), b"kept").unwrap();
+    let (code, err) = fails(&["merge", "front0.exr", "front0.png", "-o", "front0.exr"], d);
+    let msg = "error: -o front0.exr: merge would write front0.exr, which is the part front0.exr\n";
+    assert_eq!((code, err.as_str()), (2, msg));
+    let (code, err) = fails(&["merge", "front1.exr", "front0.png", "-o", "front0.hdr"], d);
+    let msg = "error: -o front0.hdr: merge would write front0.png, which is the part front0.png\n";
+    assert_eq!((code, err.as_str()), (2, msg));
+    assert_eq!(std::fs::read(d.join("front0.exr")).unwrap(), before);
+    assert_eq!(std::fs::read(d.join("front0.png")).unwrap(), b"kept");
 }
 
 #[test]
