@@ -92,11 +92,16 @@ impl Slice {
         let k0 = self.offset.unwrap_or(0);
         let k1 = self.count.map_or(spp as u64, |n| k0 as u64 + n as u64);
         if k0 as u64 >= k1.min(spp as u64) || k1 > spp as u64 {
-            let n = k1.saturating_sub(k0 as u64);
-            return Err(Failure::Usage(format!(
-                "--sample-offset {k0} --sample-count {n}: samples {k0}..{k1} are not inside the image's \
-                 {spp} samples per pixel (--spp or the scene's NumSamples)"
-            )));
+            return Err(Failure::Usage(match self.count {
+                Some(n) => format!(
+                    "--sample-offset {k0} --sample-count {n}: samples {k0}..{k1} are not inside the image's \
+                     {spp} samples per pixel (--spp or the scene's NumSamples)"
+                ),
+                None => format!(
+                    "--sample-offset {k0}: the image has {spp} samples per pixel (--spp or the scene's \
+                     NumSamples), numbered from 0"
+                ),
+            }));
         }
         Ok((k0, k1 as u32))
     }
@@ -152,6 +157,11 @@ mod tests {
         for (k, n) in [(Some(8), None), (Some(7), Some(2)), (Some(u32::MAX), Some(u32::MAX))] {
             assert!(matches!(slice(k, n).samples(8), Err(Failure::Usage(_))), "{k:?} {n:?}");
         }
+        // The message names the flags that were given.
+        let Err(Failure::Usage(msg)) = slice(Some(5), None).samples(4) else { panic!("accepted") };
+        let want = "--sample-offset 5: the image has 4 samples per pixel (--spp or the scene's NumSamples), numbered \
+                    from 0";
+        assert_eq!(msg, want);
     }
 
     #[test]

@@ -158,7 +158,25 @@ fn farm_merge_refuses_parts_that_do_not_fit() {
     other.1.identity = "another scene".into();
     let msg =
         format!("{}: not from the same render as {} (the scene, camera or options differ)", name(&other), name(&a));
-    assert_eq!(err(&[a, other]), msg);
+    assert_eq!(err(&[a.clone(), other]), msg);
+    let mut spp = part(&scene, d, None, (2, 4));
+    spp.1.sums.spp = 8;
+    let msg = format!("{}: not from the same render as {} (the samples per pixel differ)", name(&spp), name(&a));
+    assert_eq!(err(&[a.clone(), spp]), msg);
+    let mut scale = part(&scene, d, None, (2, 4));
+    scale.1.sums.scale *= 2.0;
+    let msg = format!("{}: not from the same render as {} (the radiance scale differs)", name(&scale), name(&a));
+    assert_eq!(err(&[a.clone(), scale]), msg);
+
+    // A slice whose window leaves its frame is refused when read.
+    let mut wide = a.1.clone();
+    let (w, h) = wide.sums.frame;
+    wide.sums.frame = (w - 1, h);
+    let path = d.join("wide.exr");
+    write_partial(&path, &wide).unwrap();
+    let e = read_partial(&path).unwrap_err().to_string();
+    let msg = format!("the data window ({w} x {h} pixels at (0, 0)) is not inside the {} x {h} frame", w - 1);
+    assert_eq!(e, format!("{}: {msg}", path.display()));
 }
 
 #[test]

@@ -26,18 +26,18 @@ pub fn merge(parts: &[(PathBuf, Partial)]) -> Result<Film> {
     for (path, p) in &parts[1..] {
         let s = &p.sums;
         let differs = if p.identity != first.identity {
-            Some("scene, camera or options")
+            Some("the scene, camera or options differ")
         } else if s.frame != f.frame {
-            Some("frame size")
+            Some("the frame size differs")
         } else if s.spp != f.spp {
-            Some("samples per pixel")
+            Some("the samples per pixel differ")
         } else if s.scale.to_bits() != f.scale.to_bits() {
-            Some("radiance scale")
+            Some("the radiance scale differs")
         } else {
             None
         };
         if let Some(what) = differs {
-            let msg = format!("not from the same render as {} (the {what} differ)", first_path.display());
+            let msg = format!("not from the same render as {} ({what})", first_path.display());
             return Err(Error::input(Location::file(path), msg));
         }
     }

@@ -135,10 +135,14 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
     let frame = (dw.size.0 as u32, dw.size.1 as u32);
     let (x0, y0) = (pos.0.max(0) as u32, pos.1.max(0) as u32);
     let window = (x0, y0, x0 + size.0 as u32, y0 + size.1 as u32);
-    if dw.position != Vec2(0, 0) || pos.0 < 0 || pos.1 < 0 || window.2 > frame.0 || window.3 > frame.1 {
+    if dw.position != Vec2(0, 0) {
+        let (x, y) = (dw.position.0, dw.position.1);
+        return Err(bad(format!("the display window starts at ({x}, {y}), not at (0, 0) as a frame does")));
+    }
+    if pos.0 < 0 || pos.1 < 0 || window.2 > frame.0 || window.3 > frame.1 {
         return Err(bad(format!(
-            "data window {:?}+{:?} is not inside the display window {:?}+{:?}",
-            pos, size, dw.position, dw.size
+            "the data window ({} x {} pixels at ({}, {})) is not inside the {} x {} frame",
+            size.0, size.1, pos.0, pos.1, frame.0, frame.1
         )));
     }
     let n = size.0 * size.1;
