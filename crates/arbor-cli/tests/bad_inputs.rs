@@ -104,6 +104,10 @@ fn catalogue() -> Vec<Row> {
     render("area_light_zero_normal.xml", 3, "error: area_light_zero_normal.xml:17:13: <Normal>: zero vector\n"),
     render("area_light_nan_radiance.xml", 3, "error: area_light_nan_radiance.xml:19:13: <Radiance>: non-finite number 'nan'\n"),
     render("roughness_negative.xml", 3, "error: roughness_negative.xml:21:13: Material 1: negative roughness -0.2\n"),
+    render("phong_exponent_negative.xml", 3, "error: phong_exponent_negative.xml:21:13: Material 1: negative PhongExponent -5\n"),
+    render("refraction_index_zero.xml", 3, "error: refraction_index_zero.xml:21:13: Material 1: RefractionIndex 0 must be positive\n"),
+    render("absorption_index_negative.xml", 3, "error: absorption_index_negative.xml:21:96: Material 1: negative AbsorptionIndex -5\n"),
+    render("point_light_negative_intensity.xml", 3, "error: point_light_negative_intensity.xml:15:54: PointLight 1: negative Intensity [-900, 900, 900]\n"),
     // BRDFs: a material naming a model that is not there, a model the course does not define, a negative
     // exponent, an option that is not a boolean, Torrance-Sparrow without the index of its Fresnel term.
     render("brdf_missing.xml", 3, "error: brdf_missing.xml:22:26: Material 1: unknown BRDF id '2'\n"),

@@ -16,7 +16,7 @@ impl Reader<'_> {
             let light = match n.name.as_str() {
                 "PointLight" => LightDesc::Point {
                     position: self.req(n, "Position")?.vec3(p)?,
-                    intensity: self.req(n, "Intensity")?.vec3(p)?,
+                    intensity: self.intensity(n, "PointLight")?,
                 },
                 "AreaLight" => self.area_light(n)?,
                 "SpotLight" => self.spot_light(n)?,
@@ -89,13 +89,25 @@ impl Reader<'_> {
         Ok(LightDesc::Area { position, normal, size, radiance })
     }
 
+    /// The `Intensity` of a light `kind`: required and not negative (a negative one would subtract
+    /// light, which no renderer of the course does).
+    fn intensity(&mut self, n: &Node, kind: &str) -> Result<crate::math::Color> {
+        let i = self.req(n, "Intensity")?;
+        let intensity = i.vec3(self.path)?;
+        if intensity.cmplt(crate::math::Color::ZERO).any() {
+            let id = n.attr("id").map_or("(no id)", |a| a.trimmed());
+            return Err(self.err(i, format!("{kind} {id}: negative Intensity {intensity}")));
+        }
+        Ok(intensity)
+    }
+
     /// A `SpotLight`: full cone angles in degrees with `0 < FalloffAngle <= CoverageAngle <= 360` (the
     /// fall-off cone lies inside the coverage cone; a cone's half angle is at most 180°).
     fn spot_light(&mut self, n: &Node) -> Result<LightDesc> {
         let p = self.path;
         let position = self.req(n, "Position")?.vec3(p)?;
         let direction = self.unit(n, "Direction")?;
-        let intensity = self.req(n, "Intensity")?.vec3(p)?;
+        let intensity = self.intensity(n, "SpotLight")?;
         let (cov_node, fall_node) = (self.req(n, "CoverageAngle")?, self.req(n, "FalloffAngle")?);
         let (coverage_deg, falloff_deg) = (cov_node.float(p)?, fall_node.float(p)?);
         let name = || format!("SpotLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));

@@ -36,10 +36,28 @@ impl Reader<'_> {
         let diffuse = self.req(m, "DiffuseReflectance")?.vec3(p)?;
         let specular = color(self, "SpecularReflectance")?.unwrap_or(Color::ZERO);
         let phong_exponent = match self.one(m, "PhongExponent") {
-            Some(n) => n.float(p)?,
+            Some(n) => {
+                let e = n.float(p)?;
+                if e < 0.0 {
+                    return Err(self.err(n, format!("Material {id}: negative PhongExponent {e}")));
+                }
+                e
+            }
             None => 1.0,
         };
-        let float = |r: &mut Self, name: &str| -> Result<f32> { r.req(m, name)?.float(p) };
+        // A refraction index must be positive, an absorption index not negative: others have no
+        // physical reading and make the Fresnel terms NaN or negative.
+        let float = |r: &mut Self, name: &str| -> Result<f32> {
+            let n = r.req(m, name)?;
+            let v = n.float(p)?;
+            match name {
+                "RefractionIndex" if v <= 0.0 => {
+                    Err(r.err(n, format!("Material {id}: RefractionIndex {v} must be positive")))
+                }
+                "AbsorptionIndex" if v < 0.0 => Err(r.err(n, format!("Material {id}: negative AbsorptionIndex {v}"))),
+                _ => Ok(v),
+            }
+        };
         let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
             Some((_, t)) if t == "mirror" => {
                 MaterialKind::Mirror { reflectance: self.req(m, "MirrorReflectance")?.vec3(p)? }
