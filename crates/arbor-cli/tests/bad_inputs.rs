@@ -49,6 +49,7 @@ fn catalogue() -> Vec<Row> {
     render("mesh_truncated_obj.xml", 3, "error: truncated.obj:4: face has 2 vertices (a face needs at least 3)\n"),
     render("mesh_empty_ply.xml", 3, "error: empty.ply:1: not a PLY file (the first line must be `ply`)\n"),
     render("mesh_empty_off.xml", 3, "error: mesh_empty_off.xml:29:9: Mesh 1: mesh file 'empty.off': empty file (expected `OFF`)\n"),
+    render("mesh_no_faces_obj.xml", 3, "error: mesh_no_faces_obj.xml:29:9: Mesh 1: mesh file 'no_faces.obj' holds no triangles\n"),
     // Headers that claim more elements than the file holds: refused before allocating.
     render("mesh_huge_count_ply.xml", 3, "error: huge_count.ply:3: element `vertex` claims 4000000000 entries but only 1 lines are left for it\n"),
     render("mesh_huge_count_binary.xml", 3, "error: huge_count_binary.ply:3: element `vertex` claims 1000000000 entries (at least 12000000000 bytes) but only 12 bytes are left for it\n"),

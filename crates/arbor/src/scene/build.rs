@@ -361,6 +361,12 @@ fn load_mesh_files(desc: &SceneDesc) -> Result<HashMap<PathBuf, Arc<TriangleMesh
                 }
                 other => other,
             })?;
+            // A file that parses to nothing (an OBJ reader skips lines it does not know, so any text
+            // does) is never what the scene meant.
+            if mesh.is_empty() {
+                let msg = format!("{}: mesh file '{}' holds no triangles", object.name, path.display());
+                return Err(Error::input(object.loc.clone(), msg));
+            }
             Ok(((*path).clone(), Arc::new(mesh)))
         })
         .collect()
