@@ -2,7 +2,8 @@
 //!
 //! Positions come from the document's byte ranges. roxmltree's own `text_pos_at` rescans the text
 //! from the start on every call, which is quadratic on the multi-megabyte files with inline vertex data;
-//! a table of line starts turns each lookup into a binary search.
+//! a table of line starts turns each lookup into a binary search, and the column is counted on from the
+//! previous lookup, since the tree is walked in document order and a scene may be one long line.
 
 use std::path::Path;
 
@@ -12,7 +13,7 @@ use crate::{Error, Location, Result};
 /// Parses `text` (the content of `path`) into the tree of its root element.
 pub fn parse(text: &str, path: &Path) -> Result<Node> {
     let opts = roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() };
-    let lines = LineIndex::new(text);
+    let mut lines = LineIndex::new(text);
     let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
         let pos = e.pos();
         let msg = e.to_string();
@@ -25,14 +26,14 @@ pub fn parse(text: &str, path: &Path) -> Result<Node> {
         };
         Error::input(Location::at(path, row, col), format!("XML syntax error: {msg}"))
     })?;
-    convert(doc.root_element(), &lines, 0, path)
+    convert(doc.root_element(), &mut lines, 0, path)
 }
 
 /// Deeper than any scene needs; the tree is walked recursively, so a hostile file must not nest
 /// without bound (serde_json applies a similar limit, 128, to JSON).
 const MAX_DEPTH: usize = 128;
 
-fn convert(e: roxmltree::Node<'_, '_>, lines: &LineIndex<'_>, depth: usize, path: &Path) -> Result<Node> {
+fn convert(e: roxmltree::Node<'_, '_>, lines: &mut LineIndex<'_>, depth: usize, path: &Path) -> Result<Node> {
     let (line, col) = lines.pos(e.range().start);
     if depth > MAX_DEPTH {
         let msg = format!("elements nested more than {MAX_DEPTH} deep");
@@ -59,17 +60,44 @@ fn convert(e: roxmltree::Node<'_, '_>, lines: &LineIndex<'_>, depth: usize, path
 struct LineIndex<'a> {
     text: &'a str,
     starts: Vec<usize>,
+    /// The last offset looked up and its column (0-based): a later offset on the same line counts
+    /// only the characters in between.
+    last: (usize, usize),
+    /// Bytes counted over, so that a test can hold the walk to linear work.
+    #[cfg(test)]
+    scanned: usize,
 }
 
 impl<'a> LineIndex<'a> {
     fn new(text: &'a str) -> Self {
         let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
-        LineIndex { text, starts }
+        LineIndex {
+            text,
+            starts,
+            last: (0, 0),
+            #[cfg(test)]
+            scanned: 0,
+        }
     }
-    fn pos(&self, byte: usize) -> (u32, u32) {
+    fn pos(&mut self, byte: usize) -> (u32, u32) {
         let line = self.starts.partition_point(|&s| s <= byte).max(1) - 1;
         let start = self.starts[line];
-        let col = self.text.get(start..byte).map_or(0, |s| s.chars().count());
+        let (from, before) = match self.last {
+            (b, col) if (start..=byte).contains(&b) => (b, col),
+            _ => (start, 0),
+        };
+        let col = match self.text.get(from..byte) {
+            Some(s) => {
+                #[cfg(test)]
+                {
+                    self.scanned += s.len();
+                }
+                let col = before + s.chars().count();
+                self.last = (byte, col);
+                col
+            }
+            None => 0,
+        };
         (line as u32 + 1, col as u32 + 1)
     }
 }
@@ -113,6 +141,34 @@ mod tests {
         let text = format!("{}{}", "<a>".repeat(1000), "</a>".repeat(1000));
         let e = parse(&text, Path::new("deep.xml")).unwrap_err();
         assert_eq!(e.to_string(), "deep.xml:1:388: elements nested more than 128 deep");
+    }
+
+    #[test]
+    fn xml_positions_on_a_long_line_count_characters_in_any_order() {
+        let line = "<Sphere id=\"ö\"> <Radius>é 1</Radius> </Sphere> ".repeat(50);
+        let text = format!("<Scene>\n{line}\n{line}</Scene>");
+        let direct = |byte: usize| {
+            let start = text[..byte].rfind('\n').map_or(0, |i| i + 1);
+            let line = text[..byte].matches('\n').count() + 1;
+            (line as u32, text[start..byte].chars().count() as u32 + 1)
+        };
+        let starts: Vec<usize> = text.match_indices('<').map(|(i, _)| i).collect();
+        let mut lines = LineIndex::new(&text);
+        // Document order, then backwards, then jumping between lines.
+        let order = starts.iter().chain(starts.iter().rev()).chain(starts.iter().step_by(7).rev().step_by(3));
+        for &byte in order.chain([&text.len(), &0]) {
+            assert_eq!(lines.pos(byte), direct(byte), "byte {byte}");
+        }
+    }
+
+    #[test]
+    fn xml_positions_in_document_order_scan_the_text_once() {
+        let text = format!("<Scene>{}</Scene>", "<Sphere id=\"ö\"><Radius>1</Radius></Sphere>".repeat(1000));
+        let mut lines = LineIndex::new(&text);
+        for (byte, _) in text.match_indices('<') {
+            lines.pos(byte);
+        }
+        assert!(lines.scanned <= text.len(), "{} bytes scanned for {}", lines.scanned, text.len());
     }
 
     #[test]
