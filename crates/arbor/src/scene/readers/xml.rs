@@ -14,7 +14,7 @@ use crate::{Error, Location, Result};
 pub fn parse(text: &str, path: &Path) -> Result<Node> {
     let opts = roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() };
     let mut lines = LineIndex::new(text);
-    let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
+    let syntax_error = |e: roxmltree::Error, lines: &mut LineIndex<'_>| {
         let pos = e.pos();
         let msg = e.to_string();
         // roxmltree appends the position to its message; the location already says it.
@@ -25,7 +25,18 @@ pub fn parse(text: &str, path: &Path) -> Result<Node> {
             _ => (pos.row, pos.col),
         };
         Error::input(Location::at(path, row, col), format!("XML syntax error: {msg}"))
-    })?;
+    };
+    // roxmltree recurses once per nesting level and would overflow the stack on a hostile file before
+    // `convert` could refuse it. Errors stay in document order: a syntax error before the deep element
+    // is still the one reported, found by parsing only the text before it.
+    if let Some(at) = too_deep(text) {
+        match roxmltree::Document::parse_with_options(&text[..at], opts) {
+            Err(roxmltree::Error::UnexpectedEndOfStream | roxmltree::Error::UnclosedRootNode) | Ok(_) => {}
+            Err(e) => return Err(syntax_error(e, &mut lines)),
+        }
+        return Err(nested_too_deep(path, lines.pos(at)));
+    }
+    let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| syntax_error(e, &mut lines))?;
     convert(doc.root_element(), &mut lines, 0, path)
 }
 
@@ -36,8 +47,7 @@ const MAX_DEPTH: usize = 128;
 fn convert(e: roxmltree::Node<'_, '_>, lines: &mut LineIndex<'_>, depth: usize, path: &Path) -> Result<Node> {
     let (line, col) = lines.pos(e.range().start);
     if depth > MAX_DEPTH {
-        let msg = format!("elements nested more than {MAX_DEPTH} deep");
-        return Err(Error::input(Location::at(path, line, col), msg));
+        return Err(nested_too_deep(path, (line, col)));
     }
     let mut node = Node::new(e.tag_name().name(), line, col);
     for a in e.attributes() {
@@ -54,6 +64,114 @@ fn convert(e: roxmltree::Node<'_, '_>, lines: &mut LineIndex<'_>, depth: usize, 
         }
     }
     Ok(node)
+}
+
+fn nested_too_deep(path: &Path, (line, col): (u32, u32)) -> Error {
+    Error::input(Location::at(path, line, col), format!("elements nested more than {MAX_DEPTH} deep"))
+}
+
+/// The byte offset of the first element with more than [`MAX_DEPTH`] open ancestors, or of such an
+/// element in an entity's value, found by a forward scan that tokenizes only as far as roxmltree's
+/// nesting goes. Where the scan gives up (an unterminated comment, an unknown declaration), roxmltree
+/// stops with a syntax error at the same place, so nothing deeper is ever parsed. Nesting built up
+/// through entity references is bounded by roxmltree's own limit on their depth, and left to `convert`.
+fn too_deep(text: &str) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while let Some(lt) = text.get(i..)?.find('<') {
+        let at = i + lt;
+        let rest = &b[at..];
+        i = if rest.starts_with(b"<!--") {
+            after(text, at + 4, "-->")?
+        } else if rest.starts_with(b"<![CDATA[") {
+            after(text, at + 9, "]]>")?
+        } else if rest.starts_with(b"<?") {
+            after(text, at + 2, "?>")?
+        } else if rest.starts_with(b"<!DOCTYPE") {
+            match doctype(text, at + 9)? {
+                Ok(end) => end,
+                Err(deep) => return Some(deep),
+            }
+        } else if rest.starts_with(b"<!") {
+            return None;
+        } else if rest.starts_with(b"</") {
+            depth = depth.saturating_sub(1);
+            after(text, at + 2, ">")?
+        } else {
+            if depth > MAX_DEPTH {
+                return Some(at);
+            }
+            let end = tag_end(text, at + 1)?;
+            if b[end - 2] != b'/' {
+                depth += 1;
+            }
+            end
+        };
+    }
+    None
+}
+
+/// The offset just past the first `end` at or after `from`.
+fn after(text: &str, from: usize, end: &str) -> Option<usize> {
+    Some(from + text.get(from..)?.find(end)? + end.len())
+}
+
+/// The offset just past the `>` closing a tag, skipping quoted attribute values (which may hold `>`).
+fn tag_end(text: &str, mut i: usize) -> Option<usize> {
+    loop {
+        let at = i + text.get(i..)?.find(['>', '"', '\''])?;
+        match text.as_bytes()[at] {
+            b'>' => return Some(at + 1),
+            q => i = after(text, at + 1, if q == b'"' { "\"" } else { "'" })?,
+        }
+    }
+}
+
+/// The end of a DOCTYPE whose name starts at `i` (`Ok`), or the offset of an element nested too deep in
+/// one of its entity values (`Err`). Follows roxmltree's grammar: quoted literals in the external ID and
+/// in entity declarations, other declarations up to the first `>` whatever their quotes.
+fn doctype(text: &str, mut i: usize) -> Option<Result<usize, usize>> {
+    let b = text.as_bytes();
+    loop {
+        let at = i + text.get(i..)?.find(['>', '[', '"', '\''])?;
+        match b[at] {
+            b'>' => return Some(Ok(at + 1)),
+            b'[' => {
+                i = at + 1;
+                break;
+            }
+            q => i = after(text, at + 1, if q == b'"' { "\"" } else { "'" })?,
+        }
+    }
+    loop {
+        let at = i + text.get(i..)?.find(|c: char| !c.is_ascii_whitespace())?;
+        let rest = &b[at..];
+        i = if rest.starts_with(b"<!ENTITY") {
+            let mut j = at + 8;
+            loop {
+                let k = j + text.get(j..)?.find(['>', '"', '\''])?;
+                if b[k] == b'>' {
+                    break k + 1;
+                }
+                let end = after(text, k + 1, if b[k] == b'"' { "\"" } else { "'" })?;
+                if let Some(deep) = too_deep(&text[k + 1..end - 1]) {
+                    return Some(Err(k + 1 + deep));
+                }
+                j = end;
+            }
+        } else if rest.starts_with(b"<!--") {
+            after(text, at + 4, "-->")?
+        } else if rest.starts_with(b"<?") {
+            after(text, at + 2, "?>")?
+        } else if rest.starts_with(b"<!") {
+            after(text, at + 2, ">")?
+        } else if rest.starts_with(b"]") {
+            return Some(Ok(after(text, at + 1, ">")?));
+        } else {
+            return None;
+        };
+    }
 }
 
 /// Byte offset to 1-based line and column (in characters).
@@ -169,6 +287,48 @@ mod tests {
             lines.pos(byte);
         }
         assert!(lines.scanned <= text.len(), "{} bytes scanned for {}", lines.scanned, text.len());
+    }
+
+    #[test]
+    fn xml_nesting_too_deep_for_the_parser_is_refused_before_parsing() {
+        let n = 20_000;
+        let text = format!("{}{}", "<a>".repeat(n), "</a>".repeat(n));
+        let e = parse(&text, Path::new("deep.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "deep.xml:1:388: elements nested more than 128 deep");
+        let text = format!("<Scene>\n  <Cameras/>\n  {}{}\n</Scene>\n", "<Foo>".repeat(n), "</Foo>".repeat(n));
+        let e = parse(&text, Path::new("scene.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "scene.xml:3:643: elements nested more than 128 deep");
+    }
+
+    #[test]
+    fn xml_depth_scan_skips_what_is_not_an_element() {
+        // A root and 128 levels below it are allowed; no `<` below that which is not an element counts.
+        let inner = "<!-- <a> --><![CDATA[<a>]]><?pi <a>?><b x=\"a>\" y='/>'/>";
+        let text = format!(
+            "<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY e \"<a/>\"><!-- <a> --><!ELEMENT a ANY>]>{}{inner}{}",
+            "<a>".repeat(128),
+            "</a>".repeat(128)
+        );
+        assert_eq!(too_deep(&text), None);
+        parse(&text, Path::new("s.xml")).unwrap();
+        let text = text.replacen("]><a>", "]><a><a>", 1);
+        let e = parse(&text, Path::new("s.xml")).unwrap_err();
+        assert!(e.to_string().ends_with(": elements nested more than 128 deep"), "{e}");
+    }
+
+    #[test]
+    fn xml_depth_scan_reads_entity_values() {
+        let deep = format!("{}{}", "<a>".repeat(20_000), "</a>".repeat(20_000));
+        let text = format!("<!DOCTYPE r [\n<!ENTITY e '{deep}'>\n]>\n<r>&e;</r>");
+        let e = parse(&text, Path::new("ent.xml")).unwrap_err();
+        assert_eq!(e.to_string(), "ent.xml:2:400: elements nested more than 128 deep");
+    }
+
+    #[test]
+    fn xml_syntax_error_before_deep_nesting_is_reported_first() {
+        let text = format!("<r><b x=1/>{}{}</r>", "<a>".repeat(20_000), "</a>".repeat(20_000));
+        let e = parse(&text, Path::new("bad.xml")).unwrap_err();
+        assert!(e.to_string().starts_with("bad.xml:1:9: XML syntax error: expected a quote"), "{e}");
     }
 
     #[test]
