@@ -56,6 +56,22 @@ struct Split {
     /// Whether primitives lying in the plane go to the left (below) child.
     planar_left: bool,
     cost: f64,
+    /// Primitives whose bounds reach each side, planar ones included on their side (an upper bound
+    /// on the children's counts: clipping may drop some).
+    counts: [usize; 2],
+}
+
+/// Most bad refines ([`is_bad_refine`]) on the path from the root to any node (pbrt's limit of 3).
+const MAX_BAD_REFINES: usize = 3;
+
+/// A split of `n` primitives is a bad refine when its children together hold more than 1.5 n of
+/// them: the primitives straddling the plane are copied to both sides, and a tree made mostly of such
+/// splits grows exponentially with depth while its leaves barely shrink (flat primitives overlapping
+/// in one plane, where the SAH always finds a slightly cheaper split). A split with an empty side is
+/// never bad: that side is a leaf, so it cannot branch.
+fn is_bad_refine(split: &Split, n: usize) -> bool {
+    let [l, r] = split.counts;
+    l > 0 && r > 0 && 2 * (l + r) > 3 * n
 }
 
 /// Nodes with at least this many primitives build their two children in parallel.
@@ -99,7 +115,7 @@ pub(super) fn build_split_at<P: Primitives + ?Sized>(
     // `order` is total (a primitive has one event of a kind per axis), so the parallel sort is deterministic.
     events.par_iter_mut().for_each(|list| list.par_sort_unstable_by(order));
     let mut builder = Builder::new(prims, params, max_depth, parallel_min);
-    builder.build_node(events, &bounds, live, 0);
+    builder.build_node(events, &bounds, live, 0, 0);
     (builder.nodes, builder.refs, bounds)
 }
 
@@ -191,7 +207,9 @@ fn sah(bx: &Aabb, area: f64, axis: usize, pos: f32, [left, planar, right]: [usiz
     };
     let (to_left, to_right) = (cost(left + planar, right), cost(left, right + planar));
     let planar_left = to_left <= to_right;
-    Split { axis, pos, planar_left, cost: if planar_left { to_left } else { to_right } }
+    let (cost, counts) =
+        if planar_left { (to_left, [left + planar, right]) } else { (to_right, [left, right + planar]) };
+    Split { axis, pos, planar_left, cost, counts }
 }
 
 /// The recursive builder, writing nodes depth first.
@@ -219,9 +237,11 @@ impl<'a, P: Primitives + ?Sized> Builder<'a, P> {
         }
     }
 
-    fn build_node(&mut self, events: Events, bx: &Aabb, n: usize, depth: usize) {
+    /// Builds the subtree of a node at `depth` below `bad` bad refines.
+    fn build_node(&mut self, events: Events, bx: &Aabb, n: usize, depth: usize, bad: usize) {
         let split = if depth < self.max_depth && n > 0 { find_split(&events, bx, n, &self.params) } else { None };
-        let Some(split) = split else {
+        let split = split.map(|s| (s, bad + is_bad_refine(&s, n) as usize));
+        let Some((split, bad)) = split.filter(|&(_, bad)| bad <= MAX_BAD_REFINES) else {
             return self.make_leaf(&events[0]);
         };
         let (below, above) = split_box(bx, split.axis, split.pos);
@@ -229,15 +249,15 @@ impl<'a, P: Primitives + ?Sized> Builder<'a, P> {
         let me = self.nodes.len();
         self.nodes.push(Node::leaf(0, 0));
         if n < self.parallel_min {
-            self.build_node(left, &below, n_left, depth + 1);
+            self.build_node(left, &below, n_left, depth + 1, bad);
             self.nodes[me] = Node::inner(split.axis, split.pos, self.nodes.len() as u32);
-            self.build_node(right, &above, n_right, depth + 1);
+            self.build_node(right, &above, n_right, depth + 1, bad);
             return;
         }
         let mut other = Builder::new(self.prims, &self.params, self.max_depth, self.parallel_min);
         rayon::join(
-            || self.build_node(left, &below, n_left, depth + 1),
-            || other.build_node(right, &above, n_right, depth + 1),
+            || self.build_node(left, &below, n_left, depth + 1, bad),
+            || other.build_node(right, &above, n_right, depth + 1, bad),
         );
         self.nodes[me] = Node::inner(split.axis, split.pos, self.nodes.len() as u32);
         self.append(other);

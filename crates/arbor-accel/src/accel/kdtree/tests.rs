@@ -287,3 +287,73 @@ fn kdtree_parallel_build_writes_the_sequential_tree() {
     }
     assert!(sequential.0.len() > 1000 && !sequential.1.is_empty());
 }
+
+/// Random triangles lying in the plane z = 0, coordinates in [-5, 5].
+fn coplanar(n: usize, seed: u64) -> TriangleMesh {
+    let mut rng = Rng(seed);
+    let mut point = || Vec3::new(rng.f32() * 10.0 - 5.0, rng.f32() * 10.0 - 5.0, 0.0);
+    let tris: Vec<_> = (0..n).map(|_| [point(), point(), point()]).collect();
+    mesh_of(&tris)
+}
+
+/// Sum of the primitive counts of the leaves and inner nodes at each depth: the inner nodes' counts are
+/// those of their subtrees' leaves at that depth, so per depth it is the sum over the nodes' own sets.
+fn refs_per_depth(tree: &KdTree) -> Vec<usize> {
+    fn count(tree: &KdTree, i: usize, depth: usize, out: &mut Vec<(usize, Vec<u32>)>) -> Vec<u32> {
+        let node = tree.nodes[i];
+        let prims = if node.is_leaf() {
+            node.prims(&tree.refs).to_vec()
+        } else {
+            let mut p = count(tree, i + 1, depth + 1, out);
+            p.extend(count(tree, node.above(), depth + 1, out));
+            p.sort_unstable();
+            p.dedup();
+            p
+        };
+        out.push((depth, prims.clone()));
+        prims
+    }
+    let mut nodes = Vec::new();
+    if !tree.nodes.is_empty() {
+        count(tree, 0, 0, &mut nodes);
+    }
+    let mut per_depth = vec![0; nodes.iter().map(|(d, _)| d + 1).max().unwrap_or(0)];
+    for (d, prims) in &nodes {
+        per_depth[*d] += prims.len();
+    }
+    per_depth
+}
+
+#[test]
+fn kdtree_coplanar_triangles_build_a_small_tree() {
+    // Overlapping triangles in one plane: every split the SAH finds copies most of them to both sides,
+    // so without the bad-refine limit the tree grows as 2^depth (thousands of references per triangle).
+    let n = 300;
+    let mesh = coplanar(n, 11);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    tree.validate(&mesh).unwrap();
+    assert!(tree.nodes().len() <= 40 * n, "{} nodes", tree.nodes().len());
+    assert!(tree.prim_refs().len() <= 40 * n, "{} references", tree.prim_refs().len());
+    // The module's bound: at most 2^3 (3/2)^d N references at depth d.
+    for (d, &refs) in refs_per_depth(&tree).iter().enumerate() {
+        assert!(refs as f64 <= 8.0 * 1.5f64.powi(d as i32) * n as f64, "{refs} references at depth {d}");
+    }
+    let brute = BruteForce::build(&mesh);
+    let mut rng = Rng(12);
+    for _ in 0..2_000 {
+        let from = Vec3::new(rng.f32() * 12.0 - 6.0, rng.f32() * 12.0 - 6.0, 1.0 + rng.f32());
+        let ray = Ray::new(from, rng.vec3() - Vec3::new(0.5, 0.5, 1.0));
+        assert_eq!(tree.intersect(&mesh, &ray, f32::INFINITY), brute.intersect(&mesh, &ray, f32::INFINITY));
+    }
+}
+
+#[test]
+fn kdtree_reference_bound_holds_on_ordinary_scenes() {
+    // The per-depth reference bound holds on ordinary input too.
+    let n = 2_000;
+    let mesh = soup(n, 23);
+    let tree = KdTree::build(&mesh, &KdTreeParams::default());
+    for (d, &refs) in refs_per_depth(&tree).iter().enumerate() {
+        assert!(refs as f64 <= 8.0 * 1.5f64.powi(d as i32) * n as f64, "{refs} references at depth {d}");
+    }
+}
