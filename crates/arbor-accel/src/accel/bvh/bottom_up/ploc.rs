@@ -4,10 +4,10 @@
 //! Primitives are sorted by the 63-bit Morton code of their centroid (21 bits per axis, over the
 //! centroids' bounds; ties by index), which puts spatially close clusters close in the array. Then,
 //! until one cluster is left: every cluster finds its nearest neighbour among the `radius` clusters on
-//! either side, by the surface area of the merged box (ties to the lower position); mutual nearest
-//! neighbours merge, the merged cluster taking the lower position; the array is compacted, keeping the
-//! order. The globally least pair within reach is always mutual (the order on pairs is total), so
-//! every iteration merges at least once.
+//! either side, by the surface area of the merged box (ties by [`tie_key`], nearer first); mutual
+//! nearest neighbours merge, the merged cluster taking the lower position; the array is compacted,
+//! keeping the order. The globally least pair within reach is always mutual (the order on pairs is
+//! total), so every iteration merges at least once.
 //!
 //! Cost: O(n log n) for the sort; each iteration is O(m · radius) for m clusters, run in parallel
 //! (rayon), and merging plus compaction is one O(m) pass. On real meshes a large share of the clusters
@@ -49,18 +49,29 @@ pub(super) fn cluster(prims: &[BuildPrim], radius: usize) -> Vec<Cluster> {
     arena
 }
 
-/// The position within `radius` of `i` whose merged box with `i` has the least area, ties to the lower
-/// position.
+/// The position within `radius` of `i` whose merged box with `i` has the least area, ties broken by
+/// [`tie_key`].
 fn nearest(boxes: &[Aabb], i: usize, radius: usize) -> usize {
     let (lo, hi) = (i.saturating_sub(radius), (i + radius + 1).min(boxes.len()));
     let mut best = (f64::INFINITY, usize::MAX);
     for j in (lo..hi).filter(|&j| j != i) {
         let a = boxes[i].union(boxes[j]).area_f64();
-        if best.1 == usize::MAX || a < best.0 {
+        if best.1 == usize::MAX || a < best.0 || (a == best.0 && tie_key(i, j) < tie_key(i, best.1)) {
             best = (a, j);
         }
     }
     best.1
+}
+
+/// Order among pairs of positions `{i, j}` of equal cost: nearer first, then, of the two candidates at
+/// distance `d` from a position, the one making a pair whose lower position `p` has `p / d` even,
+/// then the lower position. It depends on the pair only, so the globally least pair is still mutual;
+/// and clusters with equal boxes (duplicate primitives) pair off as `{0, 1}, {2, 3}, ...`, halving
+/// their number per iteration, where "ties to the lower position" would make `{0, 1}` the only
+/// mutual pair and the clustering quadratic.
+fn tie_key(i: usize, j: usize) -> (usize, usize, usize) {
+    let (p, d) = (i.min(j), i.abs_diff(j));
+    (d, (p / d) % 2, p)
 }
 
 /// Live primitive positions sorted by the Morton code of their centroids, ties by position.

@@ -191,3 +191,15 @@ fn bottom_up_params_parse_keys_and_presets() {
         assert_matches_brute(&mesh, &bvh, &rays(300, 8));
     }
 }
+
+#[test]
+fn ploc_pairs_off_identical_clusters_into_a_balanced_tree() {
+    // Equal boxes tie on every merge cost: the tie order must still pair most clusters each iteration
+    // (a chain here means one merge per iteration, quadratic time).
+    for n in [2, 3, 1_000, 4_097] {
+        let prims: Vec<_> = (0..n).map(|i| prim([0.0; 3], [1.0, 1.0, 0.0], i)).collect();
+        let arena = ploc::cluster(&prims, 16);
+        assert_eq!(arena.len(), 2 * n as usize - 1);
+        assert_eq!(arena_height(&arena), (n as usize).next_power_of_two().trailing_zeros() as usize, "n = {n}");
+    }
+}
