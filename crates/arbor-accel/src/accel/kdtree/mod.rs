@@ -20,6 +20,15 @@
 //! its clipped bounds ([`Primitives::clipped_bounds`]) are conservative; that, not the SAH, is what
 //! makes traversal exact.
 //!
+//! Termination: a node is a leaf when no split beats the leaf's SAH cost, at pbrt's depth limit
+//! `round(8 + 1.3 log2 N)` (at most [`MAX_DEPTH`] - 1), or when its split would be the fourth bad refine
+//! on its path: a split with both sides non-empty whose sides hold more than 1.5 n of its n
+//! primitives. That bounds the duplication: weighting each node's count by 2^-(bad refines above it),
+//! the weighted sum per depth grows by at most 3/2 per level, so the references at depth d total at
+//! most 2^3 (3/2)^d N, and there are at most as many inner nodes there. Without the limit, overlapping
+//! flat primitives in one plane (where a split always looks slightly cheaper and copies nearly every
+//! primitive) give up to 2^d.
+//!
 //! Cost: the build sorts the events once (O(N log N)) and then does O(n) work per node (sweep,
 //! classification, a linear merge) plus a sort of the new events of the primitives straddling the
 //! split: O(N log N) overall under the paper's assumption that O(sqrt n) primitives straddle a node's
