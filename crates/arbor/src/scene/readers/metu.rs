@@ -72,8 +72,12 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
         r.read_materials(m)?;
     }
     if let Some(c) = r.one(root, "Cameras") {
-        for (i, cam) in c.all("Camera").enumerate() {
-            let cam = r.camera(cam, i)?;
+        for (i, node) in c.all("Camera").enumerate() {
+            let cam = r.camera(node, i)?;
+            // `--camera ID` picks a camera by its id, so two may not share one.
+            if r.desc.cameras.iter().any(|c| c.id == cam.id) {
+                return Err(r.err(node, format!("duplicate camera id '{}'", cam.id)));
+            }
             r.desc.cameras.push(cam);
         }
     }
@@ -218,12 +222,25 @@ impl Reader<'_> {
         let p = self.path;
         if let Some(n) = self.one(root, "BackgroundColor") {
             self.desc.background = n.vec3(p)?;
+            if self.desc.background.cmplt(Vec3::ZERO).any() {
+                return Err(self.err(n, format!("negative BackgroundColor {}", self.desc.background)));
+            }
         }
-        if let Some(n) = self.one(root, "ShadowRayEpsilon") {
-            self.desc.shadow_epsilon = n.float(p)?;
+        // A negative epsilon would move rays into the surfaces they leave, or stop shadow rays past
+        // their light.
+        let epsilon = |r: &mut Self, name: &str| -> Result<Option<f32>> {
+            let Some(n) = r.one(root, name) else { return Ok(None) };
+            let e = n.float(p)?;
+            if e < 0.0 {
+                return Err(r.err(n, format!("negative {name} {e}")));
+            }
+            Ok(Some(e))
+        };
+        if let Some(e) = epsilon(self, "ShadowRayEpsilon")? {
+            self.desc.shadow_epsilon = e;
         }
-        if let Some(n) = self.one(root, "IntersectionTestEpsilon") {
-            self.desc.intersection_epsilon = n.float(p)?;
+        if let Some(e) = epsilon(self, "IntersectionTestEpsilon")? {
+            self.desc.intersection_epsilon = e;
         }
         if let Some(n) = self.one(root, "MaxRecursionDepth") {
             self.desc.max_depth = n.uint(p)?;
