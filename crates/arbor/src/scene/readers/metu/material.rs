@@ -47,15 +47,18 @@ impl Reader<'_> {
         };
         // A refraction index must be positive, an absorption index not negative: others have no
         // physical reading and make the Fresnel terms NaN or negative.
-        let float = |r: &mut Self, name: &str| -> Result<f32> {
-            let n = r.req(m, name)?;
-            let v = n.float(p)?;
-            match name {
-                "RefractionIndex" if v <= 0.0 => {
-                    Err(r.err(n, format!("Material {id}: RefractionIndex {v} must be positive")))
-                }
-                "AbsorptionIndex" if v < 0.0 => Err(r.err(n, format!("Material {id}: negative AbsorptionIndex {v}"))),
-                _ => Ok(v),
+        let refraction_index = |r: &mut Self| -> Result<f32> {
+            let n = r.req(m, "RefractionIndex")?;
+            match n.float(p)? {
+                v if v <= 0.0 => Err(r.err(n, format!("Material {id}: RefractionIndex {v} must be positive"))),
+                v => Ok(v),
+            }
+        };
+        let absorption_index = |r: &mut Self| -> Result<f32> {
+            let n = r.req(m, "AbsorptionIndex")?;
+            match n.float(p)? {
+                v if v < 0.0 => Err(r.err(n, format!("Material {id}: negative AbsorptionIndex {v}"))),
+                v => Ok(v),
             }
         };
         let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
@@ -64,11 +67,11 @@ impl Reader<'_> {
             }
             Some((_, t)) if t == "conductor" => MaterialKind::Conductor {
                 reflectance: self.req(m, "MirrorReflectance")?.vec3(p)?,
-                eta: float(self, "RefractionIndex")?,
-                k: float(self, "AbsorptionIndex")?,
+                eta: refraction_index(self)?,
+                k: absorption_index(self)?,
             },
             Some((_, t)) if t == "dielectric" => MaterialKind::Dielectric {
-                eta: float(self, "RefractionIndex")?,
+                eta: refraction_index(self)?,
                 absorption: color(self, "AbsorptionCoefficient")?.unwrap_or(Color::ZERO),
             },
             Some((a, t)) => {
@@ -85,7 +88,7 @@ impl Reader<'_> {
                 let transparency_given = m.child("Transparency").is_some();
                 let transparency = color(self, "Transparency")?.unwrap_or(Color::ZERO);
                 if transparency != Color::ZERO {
-                    let eta = float(self, "RefractionIndex")?;
+                    let eta = refraction_index(self)?;
                     MaterialKind::Transparent { eta, transparency, mirror }
                 } else {
                     self.opaque_refraction_index(m, &id, transparency_given)?;
