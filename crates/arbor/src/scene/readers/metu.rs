@@ -315,6 +315,17 @@ impl Reader<'_> {
         Ok(acc)
     }
 
+    /// The child `element` of `o` (a `Radiance` or an `Intensity`): required, finite and not negative;
+    /// `name` says whose it is in the error (made only then).
+    fn non_negative(&mut self, o: &Node, element: &str, name: impl FnOnce() -> String) -> Result<Vec3> {
+        let n = self.req(o, element)?;
+        let v = n.vec3(self.path)?;
+        if v.cmplt(Vec3::ZERO).any() {
+            return Err(self.err(n, format!("{}: negative {element} {v}", name())));
+        }
+        Ok(v)
+    }
+
     /// The child `name` of `n` as a unit vector.
     fn unit(&mut self, n: &Node, name: &str) -> Result<Vec3> {
         let c = self.req(n, name)?;

@@ -16,7 +16,8 @@ impl Reader<'_> {
             let light = match n.name.as_str() {
                 "PointLight" => LightDesc::Point {
                     position: self.req(n, "Position")?.vec3(p)?,
-                    intensity: self.intensity(n, "PointLight")?,
+                    // A negative intensity would subtract light, which no renderer of the course does.
+                    intensity: self.non_negative(n, "Intensity", || light_name(n))?,
                 },
                 "AreaLight" => self.area_light(n)?,
                 "SpotLight" => self.spot_light(n)?,
@@ -78,7 +79,7 @@ impl Reader<'_> {
         let normal = self.unit(n, "Normal")?;
         let s = self.req(n, "Size")?;
         let size = s.float(p)?;
-        let name = || format!("AreaLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));
+        let name = || light_name(n);
         if size <= 0.0 {
             return Err(self.err(s, format!("{}: Size {size} must be positive", name())));
         }
@@ -89,28 +90,16 @@ impl Reader<'_> {
         Ok(LightDesc::Area { position, normal, size, radiance })
     }
 
-    /// The `Intensity` of a light `kind`: required and not negative (a negative one would subtract
-    /// light, which no renderer of the course does).
-    fn intensity(&mut self, n: &Node, kind: &str) -> Result<crate::math::Color> {
-        let i = self.req(n, "Intensity")?;
-        let intensity = i.vec3(self.path)?;
-        if intensity.cmplt(crate::math::Color::ZERO).any() {
-            let id = n.attr("id").map_or("(no id)", |a| a.trimmed());
-            return Err(self.err(i, format!("{kind} {id}: negative Intensity {intensity}")));
-        }
-        Ok(intensity)
-    }
-
     /// A `SpotLight`: full cone angles in degrees with `0 < FalloffAngle <= CoverageAngle <= 360` (the
     /// fall-off cone lies inside the coverage cone; a cone's half angle is at most 180°).
     fn spot_light(&mut self, n: &Node) -> Result<LightDesc> {
         let p = self.path;
         let position = self.req(n, "Position")?.vec3(p)?;
         let direction = self.unit(n, "Direction")?;
-        let intensity = self.intensity(n, "SpotLight")?;
+        let intensity = self.non_negative(n, "Intensity", || light_name(n))?;
         let (cov_node, fall_node) = (self.req(n, "CoverageAngle")?, self.req(n, "FalloffAngle")?);
         let (coverage_deg, falloff_deg) = (cov_node.float(p)?, fall_node.float(p)?);
-        let name = || format!("SpotLight {}", n.attr("id").map_or("(no id)", |a| a.trimmed()));
+        let name = || light_name(n);
         if !(coverage_deg > 0.0 && coverage_deg <= 360.0) {
             let msg = format!("{}: CoverageAngle {coverage_deg} must be in (0, 360] degrees", name());
             return Err(self.err(cov_node, msg));
@@ -121,4 +110,9 @@ impl Reader<'_> {
         }
         Ok(LightDesc::Spot { position, direction, intensity, coverage_deg, falloff_deg })
     }
+}
+
+/// A light element as errors name it: its kind and id (`SpotLight 2`).
+fn light_name(n: &Node) -> String {
+    format!("{} {}", n.name, n.attr("id").map_or("(no id)", |a| a.trimmed()))
 }

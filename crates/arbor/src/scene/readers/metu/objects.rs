@@ -50,7 +50,8 @@ impl Reader<'_> {
             o.mark_used();
             let id = o.attr("id").map(|a| a.trimmed().to_string());
             let name = format!("{kind} {}", id.as_deref().unwrap_or("(no id)"));
-            let emission = if kind.starts_with("Light") { Some(self.radiance(o, &name)?) } else { None };
+            let emission =
+                if kind.starts_with("Light") { Some(self.non_negative(o, "Radiance", || name.clone())?) } else { None };
             let textures = self.object_textures(o, &name)?;
             let (material, shape) = if kind == "MeshInstance" {
                 let base_id =
@@ -280,16 +281,6 @@ impl Reader<'_> {
         let msg =
             format!("{name}: texture coordinate {shown} out of range (TexCoordData has {n} pairs, numbered from 1)");
         Err(self.err(at, msg))
-    }
-
-    /// The `Radiance` of an emissive object: required, finite and not negative.
-    fn radiance(&mut self, o: &Node, name: &str) -> Result<Vec3> {
-        let r = self.req(o, "Radiance")?;
-        let radiance = r.vec3(self.path)?;
-        if radiance.cmplt(Vec3::ZERO).any() {
-            return Err(self.err(r, format!("{name}: negative Radiance {radiance}")));
-        }
-        Ok(radiance)
     }
 
     /// A child holding one vertex id (`Center`, `Point`), as the vertex.
