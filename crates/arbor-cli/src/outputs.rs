@@ -58,16 +58,15 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
         }
         let path = out.join(&cam.image_name);
         check_extension(&path).map_err(refuse)?;
-        let preview = arbor::image_io::is_hdr_path(&path).then(|| path.with_extension("png"));
-        for file in std::iter::once(&path).chain(&preview) {
+        let files = files_written(&path);
+        for file in &files {
             if let Some((_, other)) = written.iter().find(|(f, _)| f == file) {
                 let msg = format!("{} would also be written by camera {other}", file.display());
                 return Err(refuse(msg).into());
             }
         }
         check_writable(&path, true)?;
-        written.push((path.clone(), &cam.id));
-        written.extend(preview.map(|p| (p, cam.id.as_str())));
+        written.extend(files.into_iter().map(|f| (f, cam.id.as_str())));
         targets.push(path);
     }
     Ok(targets)
@@ -114,6 +113,13 @@ pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
         }
         Err(e) => Err(fail(format!("cannot write it: {e}"))),
     }
+}
+
+/// The files that writing the image `path` makes: the image, and beside a high-dynamic-range one its
+/// tone-mapped PNG (every HDR image gets one: [`hdr_preview`]).
+pub fn files_written(path: &Path) -> Vec<PathBuf> {
+    let beside = arbor::image_io::is_hdr_path(path).then(|| arbor::image_io::tone_mapped_beside(path));
+    std::iter::once(path.to_path_buf()).chain(beside).collect()
 }
 
 /// The tone mapping of the PNG beside a high-dynamic-range image `path` whose camera names none, for a
