@@ -117,13 +117,18 @@ fn after(text: &str, from: usize, end: &str) -> Option<usize> {
     Some(from + text.get(from..)?.find(end)? + end.len())
 }
 
+/// The offset just past the quoted literal whose opening quote (`"` or `'`) is at `at`.
+fn after_quoted(text: &str, at: usize) -> Option<usize> {
+    after(text, at + 1, if text.as_bytes()[at] == b'"' { "\"" } else { "'" })
+}
+
 /// The offset just past the `>` closing a tag, skipping quoted attribute values (which may hold `>`).
 fn tag_end(text: &str, mut i: usize) -> Option<usize> {
     loop {
         let at = i + text.get(i..)?.find(['>', '"', '\''])?;
         match text.as_bytes()[at] {
             b'>' => return Some(at + 1),
-            q => i = after(text, at + 1, if q == b'"' { "\"" } else { "'" })?,
+            _ => i = after_quoted(text, at)?,
         }
     }
 }
@@ -141,7 +146,7 @@ fn doctype(text: &str, mut i: usize) -> Option<Result<usize, usize>> {
                 i = at + 1;
                 break;
             }
-            q => i = after(text, at + 1, if q == b'"' { "\"" } else { "'" })?,
+            _ => i = after_quoted(text, at)?,
         }
     }
     loop {
@@ -154,7 +159,7 @@ fn doctype(text: &str, mut i: usize) -> Option<Result<usize, usize>> {
                 if b[k] == b'>' {
                     break k + 1;
                 }
-                let end = after(text, k + 1, if b[k] == b'"' { "\"" } else { "'" })?;
+                let end = after_quoted(text, k)?;
                 if let Some(deep) = too_deep(&text[k + 1..end - 1]) {
                     return Some(Err(k + 1 + deep));
                 }
