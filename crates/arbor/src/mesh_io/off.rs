@@ -36,6 +36,11 @@ pub fn parse_off(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
         r.face(i, nv, line, text, &mut poly)?;
         fan(&mut mesh.indices, &poly);
     }
+    // More lines mean a count too small: the rest of the file would be dropped without a word.
+    if let Some((line, text)) = r.next() {
+        let col = Tokens::new(text).next().map_or(1, |(col, _)| col);
+        return Err(r.err(line, col, format!("unexpected line after the last of {nf} faces")));
+    }
     Ok(mesh)
 }
 
@@ -230,5 +235,12 @@ mod tests {
         assert_eq!(err(&src), "m.off:8:4: vertex 3 has 2 coordinates, expected 3");
         let src = "OFF\n3 1 0\n0 0 0\n# gone\n\n\n";
         assert_eq!(err(src), "m.off: file ends after 1 of 3 vertices");
+    }
+
+    #[test]
+    fn off_data_after_the_last_face_is_an_error() {
+        assert_eq!(err(&format!("{SQUARE}3 0 1 2\n")), "m.off:10:1: unexpected line after the last of 1 faces");
+        // Comments and blank lines after the faces are fine.
+        assert_eq!(parse(&format!("{SQUARE}\n# end\n\n")).unwrap().indices.len(), 2);
     }
 }

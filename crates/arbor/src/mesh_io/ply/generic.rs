@@ -202,6 +202,18 @@ impl<'a> Source<'a> for Ascii<'a> {
 }
 
 impl Ascii<'_> {
+    /// Checks that nothing but blank lines follows the last element: more data means a header count
+    /// is too small, and the rest of the file would be dropped without a word.
+    pub(super) fn finish(&mut self) -> Result<()> {
+        for (n, line) in self.lines.by_ref() {
+            if let Some((col, tok)) = Tokens::new(line).next() {
+                let msg = format!("unexpected `{}` after the data of the last element", shown(tok));
+                return Err(Error::input(Location::at(self.path, n, col), msg));
+            }
+        }
+        Ok(())
+    }
+
     fn int_of(&self, tok: &[u8]) -> Result<i64> {
         parse_num(tok, self.path, self.line, self.col)
     }

@@ -72,6 +72,7 @@ fn parse_body(header: &Header, bytes: &[u8], path: &Path) -> Result<TriangleMesh
             for (e, role) in header.elements.iter().zip(&roles) {
                 read_element(&mut src, e, role, nv, &mut out)?;
             }
+            src.finish()?;
         }
         Format::Le => binary::read_binary::<binary::Le>(bytes, header, &roles, path, nv, &mut out)?,
         Format::Be => binary::read_binary::<binary::Be>(bytes, header, &roles, path, nv, &mut out)?,
@@ -554,5 +555,14 @@ property float y\nproperty float z\n";
     fn ply_ascii_extra_value_is_an_error() {
         let ascii = CUBE.replace("0 1 0\n", "0 1 0 7\n");
         assert_eq!(err(ascii.as_bytes()), "m.ply:14:7: unexpected value `7` after the end of vertex 2");
+    }
+
+    #[test]
+    fn ply_ascii_data_after_the_last_element_is_an_error() {
+        let ascii = format!("{CUBE}\n  junk\n");
+        assert_eq!(err(ascii.as_bytes()), "m.ply:27:3: unexpected `junk` after the data of the last element");
+        // A seventh face: the count is named.
+        let ascii = format!("{CUBE}3 0 1 2\n");
+        assert_eq!(err(ascii.as_bytes()), "m.ply:9: element `face` claims 6 entries but the data has 7");
     }
 }
