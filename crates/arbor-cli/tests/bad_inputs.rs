@@ -142,6 +142,7 @@ fn catalogue() -> Vec<Row> {
     render("missing_mesh_file.xml", 3, "error: missing_mesh_file.xml:29:9: Mesh 1: cannot read mesh file 'nowhere.ply': No such file or directory (os error 2)\n"),
     render("nyu_missing_mesh_file.json", 3, "error: nyu_missing_mesh_file.json:6:6: Mesh 0: cannot read mesh file 'nowhere.off': No such file or directory (os error 2)\n"),
     render("env_missing.xml", 3, "error: env_missing.xml:14:43: cannot read environment map 'sky.exr': No such file or directory (os error 2)\n"),
+    render("env_truncated.xml", 3, "error: env_truncated.xml:14:43: cannot read environment map 'truncated.png': cannot decode image: unexpected end of file (the file is truncated)\n"),
     render("unknown_mesh_extension.xml", 3, "error: unknown_mesh_extension.xml:29:9: Mesh 1: mesh file 'mesh.stl': unknown mesh file extension `.stl` (supported: .ply, .obj, .off)\n"),
     // Self references. METU has no include; a plyFile may name the scene itself, and a MeshInstance may
     // name itself or another instance (bases must be <Mesh> ids, so no cycle can be written).
@@ -211,6 +212,11 @@ fn catalogue() -> Vec<Row> {
     cmd(&["merge", "truncated.xml", "-o", "OUT/merged.png"], 3, "error: truncated.xml: not a readable OpenEXR file: invalid: file identifier missing\n"),
     cmd(&["merge", "truncated.xml", "-o", "merged.bmp"], 2, "error: cannot write .bmp images; supported: png, ppm, exr, hdr, jpg, jpeg\n"),
     cmd(&["merge", "no_such_part.exr", "-o", "OUT/merged.png"], 4, "error: no_such_part.exr: No such file or directory (os error 2)\n"),
+    // Diff: a truncated or corrupt image is bad input (exit 3) in every format; a missing one is I/O (4).
+    cmd(&["diff", "tex.png", "truncated.png"], 3, "error: truncated.png: cannot decode image: unexpected end of file (the file is truncated)\n"),
+    cmd(&["diff", "tex.png", "truncated.ppm"], 3, "error: truncated.ppm: cannot decode image: unexpected end of file (the file is truncated)\n"),
+    cmd(&["diff", "tex.png", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: Format error decoding OpenExr: invalid: reference to missing bytes\n"),
+    cmd(&["diff", "tex.png", "no_such_image.png"], 4, "error: no_such_image.png: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
     cmd(&["bench", "huge_image.xml", "--runs", "1"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
@@ -219,6 +225,7 @@ fn catalogue() -> Vec<Row> {
     render("texture_coord_out_of_range.xml", 3, "error: texture_coord_out_of_range.xml:38:66: Mesh 1: texture coordinate 3 + textureOffset 1 = 4 out of range (TexCoordData has 3 pairs, numbered from 1)\n"),
     render("texture_image_missing.xml", 3, "error: texture_image_missing.xml:24:17: cannot read texture image 'nothere.png': No such file or directory (os error 2)\n"),
     render("texture_image_unreadable.xml", 3, "error: texture_image_unreadable.xml:24:17: cannot read texture image 'not_an_image.png': cannot decode image: Format error decoding Png: Invalid PNG signature.\n"),
+    render("texture_image_truncated_png.xml", 3, "error: texture_image_truncated_png.xml:24:17: cannot read texture image 'truncated.png': cannot decode image: unexpected end of file (the file is truncated)\n"),
     render("texture_noise_scale_negative.xml", 3, "error: texture_noise_scale_negative.xml:24:75: TextureMap 1: NoiseScale -2 must be positive\n"),
     render("texture_normalizer_zero.xml", 3, "error: texture_normalizer_zero.xml:25:94: TextureMap 1: Normalizer 0 must be positive\n"),
     render("texture_unknown_decal.xml", 3, "error: texture_unknown_decal.xml:25:61: TextureMap 1: unknown DecalMode 'replace_everything'\n"),
@@ -326,7 +333,7 @@ fn bad_inputs_give_located_errors_and_never_panic() {
     );
 }
 
-/// Every scene of the catalogue has its row, and every mesh file and texture image is named by some scene
+/// Every scene of the catalogue has its row, and every mesh file and image is named by some scene
 /// or row, so that no file lies there untested.
 #[test]
 fn bad_inputs_catalogue_is_complete() {
@@ -337,7 +344,7 @@ fn bad_inputs_catalogue_is_complete() {
     for entry in std::fs::read_dir(catalogue_dir()).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
         match Path::new(&name).extension().and_then(|e| e.to_str()) {
-            Some("ply" | "obj" | "off" | "png") => meshes.push(name),
+            Some("ply" | "obj" | "off" | "png" | "ppm" | "exr" | "jpg") => meshes.push(name),
             _ => {
                 assert!(named(&name), "no row for {name}");
                 scenes.push_str(&String::from_utf8_lossy(&std::fs::read(catalogue_dir().join(&name)).unwrap()));

@@ -5,6 +5,9 @@
 //! they are decoded. Integer samples are divided
 //! by their maximum (255 or 65535), float samples (EXR, HDR) are kept as they are; grey is expanded to RGB
 //! and alpha is dropped, never composited, because references are compared as stored.
+//!
+//! A file that cannot be decoded, one cut short included, is bad input ([`Error::Input`]); only a file
+//! that cannot be read at all is an I/O error.
 
 use std::path::Path;
 
@@ -38,8 +41,15 @@ fn decode(path: &Path) -> Result<DynamicImage> {
         reader.set_format(format);
     }
     let reader = reader.with_guessed_format().map_err(|e| Error::io(path, e))?;
-    reader.decode().map_err(|e| match e {
-        image::ImageError::IoError(io) => Error::io(path, io),
-        other => Error::input(Location::file(path), format!("cannot decode image: {other}")),
+    reader.decode().map_err(|e| {
+        let why = match e {
+            // The bytes are already in memory, so a decoder's I/O error is the data's fault, never the
+            // disk's: bad input (exit 3), like any other undecodable file.
+            image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+                "unexpected end of file (the file is truncated)".to_string()
+            }
+            other => other.to_string(),
+        };
+        Error::input(Location::file(path), format!("cannot decode image: {why}"))
     })
 }

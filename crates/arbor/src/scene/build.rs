@@ -102,12 +102,16 @@ impl Scene {
 fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
     let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
-    map.map(Some).map_err(|e| match e {
-        Error::Io { source, .. } => Error::input(
-            desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source)),
-            format!("cannot read environment map '{}': {source}", path.display()),
-        ),
-        other => other,
+    map.map(Some).map_err(|e| {
+        let why = match e {
+            Error::Io { source, .. } => source.to_string(),
+            // An undecodable map file; a face of a cube-map folder keeps its own name in the message.
+            Error::Input { loc, msg } if loc.file == path => msg,
+            e @ Error::Input { .. } => e.to_string(),
+            other => return other,
+        };
+        let loc = desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source));
+        Error::input(loc, format!("cannot read environment map '{}': {why}", path.display()))
     })
 }
 
