@@ -215,6 +215,7 @@ fn catalogue() -> Vec<Row> {
     // Diff: a truncated or corrupt image is bad input (exit 3) in every format; a missing one is I/O (4).
     cmd(&["diff", "tex.png", "truncated.png"], 3, "error: truncated.png: cannot decode image: unexpected end of file (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.ppm"], 3, "error: truncated.ppm: cannot decode image: unexpected end of file (the file is truncated)\n"),
+    cmd(&["diff", "tex.png", "truncated.jpg"], 3, "error: truncated.jpg: cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: Format error decoding OpenExr: invalid: reference to missing bytes\n"),
     cmd(&["diff", "tex.png", "no_such_image.png"], 4, "error: no_such_image.png: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
@@ -225,6 +226,7 @@ fn catalogue() -> Vec<Row> {
     render("texture_coord_out_of_range.xml", 3, "error: texture_coord_out_of_range.xml:38:66: Mesh 1: texture coordinate 3 + textureOffset 1 = 4 out of range (TexCoordData has 3 pairs, numbered from 1)\n"),
     render("texture_image_missing.xml", 3, "error: texture_image_missing.xml:24:17: cannot read texture image 'nothere.png': No such file or directory (os error 2)\n"),
     render("texture_image_unreadable.xml", 3, "error: texture_image_unreadable.xml:24:17: cannot read texture image 'not_an_image.png': cannot decode image: Format error decoding Png: Invalid PNG signature.\n"),
+    render("texture_image_truncated_jpg.xml", 3, "error: texture_image_truncated_jpg.xml:24:17: cannot read texture image 'truncated.jpg': cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)\n"),
     render("texture_image_truncated_png.xml", 3, "error: texture_image_truncated_png.xml:24:17: cannot read texture image 'truncated.png': cannot decode image: unexpected end of file (the file is truncated)\n"),
     render("texture_noise_scale_negative.xml", 3, "error: texture_noise_scale_negative.xml:24:75: TextureMap 1: NoiseScale -2 must be positive\n"),
     render("texture_normalizer_zero.xml", 3, "error: texture_normalizer_zero.xml:25:94: TextureMap 1: Normalizer 0 must be positive\n"),

@@ -13,6 +13,7 @@
 //!
 //! Codecs are the `image` crate's; this module only chooses formats, converts samples and handles files.
 
+mod jpeg;
 pub mod metrics;
 pub mod noisy;
 mod read;

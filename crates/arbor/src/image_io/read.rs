@@ -36,11 +36,16 @@ pub fn read_rgb8(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 }
 
 fn decode(path: &Path) -> Result<DynamicImage> {
-    let mut reader = ImageReader::new(Cursor::new(crate::input::load_bytes(path)?));
+    let bytes = crate::input::load_bytes(path)?;
+    let mut reader = ImageReader::new(Cursor::new(&bytes[..]));
     if let Ok(format) = ImageFormat::from_path(path) {
         reader.set_format(format);
     }
     let reader = reader.with_guessed_format().map_err(|e| Error::io(path, e))?;
+    if reader.format() == Some(ImageFormat::Jpeg) && !super::jpeg::is_whole(&bytes) {
+        let msg = "cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)";
+        return Err(Error::input(Location::file(path), msg));
+    }
     reader.decode().map_err(|e| {
         let why = match e {
             // The bytes are already in memory, so a decoder's I/O error is the data's fault, never the
