@@ -90,6 +90,12 @@ fn catalogue() -> Vec<Row> {
     render("aperture_inf.xml", 3, "error: aperture_inf.xml:11:13: <ApertureSize>: non-finite number 'inf'\n"),
     render("focus_distance_zero.xml", 3, "error: focus_distance_zero.xml:10:13: Camera 1: FocusDistance 0 must be positive\n"),
     render("focus_distance_negative.json", 3, "error: focus_distance_negative.json:13:9: Camera 1: FocusDistance -5 must be positive\n"),
+    render("near_distance_zero.xml", 3, "error: near_distance_zero.xml:8:13: Camera 1: NearDistance 0 must be positive\n"),
+    render("near_distance_nan.xml", 3, "error: near_distance_nan.xml:8:13: <NearDistance>: non-finite number 'nan'\n"),
+    render("near_distance_negative.json", 3, "error: near_distance_negative.json:10:9: Camera 1: NearDistance -2 must be positive\n"),
+    render("near_plane_inverted.xml", 3, "error: near_plane_inverted.xml:7:13: Camera 1: NearPlane left 1 must be less than right -1\n"),
+    render("near_plane_empty.xml", 3, "error: near_plane_empty.xml:7:13: Camera 1: NearPlane bottom 0.5 must be less than top 0.5\n"),
+    render("fovy_180.xml", 3, "error: fovy_180.xml:7:13: Camera 1: FovY 180 must be in (0, 180) degrees\n"),
     render("area_light_zero_size.xml", 3, "error: area_light_zero_size.xml:18:13: AreaLight 1: Size 0 must be positive\n"),
     // Tone mapping and spot lights (hw5) out of range.
     render("material_degamma_unknown.xml", 3, "error: material_degamma_unknown.xml:19:26: Material 1: degamma must be true or false, not 'yes'\n"),

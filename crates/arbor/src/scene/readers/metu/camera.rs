@@ -1,6 +1,7 @@
 //! METU cameras: the image-plane window from `NearPlane`, or for `type="lookAt"` from `FovY` and the
 //! image's aspect ratio (`top = NearDistance·tan(FovY/2)`, `right = top·width/height`), the camera's
-//! transformations and its thin lens.
+//! transformations and its thin lens. The image plane lies in front of the eye (`NearDistance` > 0)
+//! and its window is neither empty nor inverted (left < right, bottom < top; `FovY` in (0, 180)).
 
 use super::Reader;
 use crate::renderer::{PathOptions, Renderer};
@@ -32,7 +33,13 @@ impl Reader<'_> {
         };
         let position = self.req(c, "Position")?.vec3(p)?;
         let up = self.req(c, "Up")?.vec3(p)?;
-        let near_distance = self.req(c, "NearDistance")?.float(p)?;
+        let near_node = self.req(c, "NearDistance")?;
+        let near_distance = near_node.float(p)?;
+        // The image plane must lie in front of the eye: at 0 every pixel's ray runs along the gaze, and
+        // behind the eye the camera would look backwards.
+        if near_distance <= 0.0 {
+            return Err(self.err(near_node, format!("Camera {id}: NearDistance {near_distance} must be positive")));
+        }
         let res_node = self.req(c, "ImageResolution")?;
         let res = res_node.ints(p)?;
         let (width, height) = match res[..] {
@@ -53,7 +60,11 @@ impl Reader<'_> {
                 Some(g) => g.vec3(p)? - position,
                 None => self.req(c, "Gaze")?.vec3(p)?,
             };
-            let fov_deg = self.req(c, "FovY")?.float(p)?;
+            let fov_node = self.req(c, "FovY")?;
+            let fov_deg = fov_node.float(p)?;
+            if !(fov_deg > 0.0 && fov_deg < 180.0) {
+                return Err(self.err(fov_node, format!("Camera {id}: FovY {fov_deg} must be in (0, 180) degrees")));
+            }
             let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
             let right = top * width as f32 / height as f32;
             (gaze, Window { left: -right, right, bottom: -top, top })
@@ -65,6 +76,13 @@ impl Reader<'_> {
             if extra > 4 {
                 let msg = format!("<NearPlane> has {extra} numbers; only the first 4 are used");
                 self.notes.plain(np.loc(p), msg);
+            }
+            // An empty window sends a whole row or column of pixels along one ray; an inverted one
+            // mirrors the image, which the format asks for with handedness="left" instead.
+            for (low, high, (a, b)) in [(v[0], v[1], ("left", "right")), (v[2], v[3], ("bottom", "top"))] {
+                if low >= high {
+                    return Err(self.err(np, format!("Camera {id}: NearPlane {a} {low} must be less than {b} {high}")));
+                }
             }
             (gaze, Window { left: v[0], right: v[1], bottom: v[2], top: v[3] })
         };
