@@ -143,6 +143,10 @@ fn catalogue() -> Vec<Row> {
     render("mesh_index_off.xml", 3, "error: index_out_of_range.off:6:7: face 0: vertex index 3 out of range (the file has 3 vertices)\n"),
     // References to missing ids or files (a file the scene names is the scene's fault: exit 3).
     render("missing_material.xml", 3, "error: missing_material.xml:29:24: Sphere 1: unknown material id '7'\n"),
+    render("scaling_overflow.xml", 3, "error: scaling_overflow.xml:29:9: <Scaling>: the transform cannot be inverted: its determinant overflows to infinity (beyond the range of 32-bit floats)\n"),
+    render("scaling_tiny.xml", 3, "error: scaling_tiny.xml:29:9: <Scaling>: the transform is too close to singular to invert: its determinant 9.999999e-34 is below 1e-30\n"),
+    render("transformations_overflow.xml", 3, "error: transformations_overflow.xml:32:82: <Transformations>: composing 's1 s1' overflows to infinity (an entry of the matrix or of its inverse is beyond the range of 32-bit floats)\n"),
+    render("instance_transform_overflow.xml", 3, "error: instance_transform_overflow.xml:33:9: MeshInstance 2: its base's transform followed by its own overflows to infinity (an entry of the matrix or of its inverse is beyond the range of 32-bit floats)\n"),
     render("missing_transformation.xml", 3, "error: missing_transformation.xml:29:82: <Transformations>: unknown transformation 't5'\n"),
     render("missing_base_mesh.xml", 3, "error: missing_base_mesh.xml:30:30: MeshInstance 2: unknown base mesh id '9'\n"),
     render("missing_mesh_file.xml", 3, "error: missing_mesh_file.xml:29:9: Mesh 1: cannot read mesh file 'nowhere.ply': No such file or directory (os error 2)\n"),

@@ -48,6 +48,11 @@ impl Transform {
     pub fn then(&self, then: &Transform) -> Transform {
         Transform { m: then.m * self.m, inv: self.inv * then.inv }
     }
+    /// True when every entry of the matrix and of its inverse is a finite number; a composition of
+    /// large (or small) factors can overflow where none of its parts does.
+    pub fn is_finite(&self) -> bool {
+        self.m.is_finite() && self.inv.is_finite()
+    }
     /// True for the identity (skips work on untransformed objects).
     pub fn is_identity(&self) -> bool {
         self.m == Mat4::IDENTITY
@@ -97,6 +102,15 @@ mod tests {
         let tangent = s.vector(Vec3::new(1.0, 1.0, 0.0));
         let n = s.normal(Vec3::new(1.0, -1.0, 0.0));
         assert!(tangent.dot(n).abs() < 1e-5);
+    }
+
+    #[test]
+    fn transform_composition_can_overflow_where_its_parts_do_not() {
+        let big = Transform::scale(Vec3::new(1e20, 1.0, 1.0)).unwrap();
+        let small = Transform::scale(Vec3::new(1e-20, 1.0, 1.0)).unwrap();
+        assert!(big.is_finite() && small.is_finite() && big.then(&small).is_finite());
+        assert!(!big.then(&big).is_finite(), "the matrix overflows");
+        assert!(!small.then(&small).is_finite(), "the inverse overflows");
     }
 
     #[test]

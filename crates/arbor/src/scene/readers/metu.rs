@@ -273,23 +273,31 @@ impl Reader<'_> {
             };
             n.mark_used();
             let id = n.attr("id").ok_or_else(|| self.err(n, format!("<{}>: missing attribute id", n.name)))?;
-            let (made, degenerate) = match prefix {
-                "t" => (Some(Transform::translate(n.vec3(p)?)), ""),
-                "s" => (Transform::scale(n.vec3(p)?), "a scale factor is zero"),
+            let (made, why) = match prefix {
+                "t" => (Some(Transform::translate(n.vec3(p)?)), String::new()),
+                "s" => {
+                    let s = n.vec3(p)?;
+                    let why = if s.cmpeq(Vec3::ZERO).any() {
+                        "a scale factor is zero".to_string()
+                    } else {
+                        why_singular(&Mat4::from_scale(s))
+                    };
+                    (Transform::scale(s), why)
+                }
                 "r" => {
                     let v = n.floats_n(4, false, p)?;
                     let axis = Vec3::new(v[1], v[2], v[3]);
-                    (Transform::rotate(v[0], axis), "the rotation axis is zero")
+                    (Transform::rotate(v[0], axis), "the rotation axis is zero".to_string())
                 }
                 _ => {
                     let v = n.floats_n(16, false, p)?;
                     let rows: [f32; 16] = v.try_into().unwrap_or([0.0; 16]);
                     // The file gives rows; glam takes columns.
                     let m = Mat4::from_cols_array(&rows).transpose();
-                    (Transform::from_mat4(m), "the matrix is not invertible")
+                    (Transform::from_mat4(m), why_singular(&m))
                 }
             };
-            let made = made.ok_or_else(|| self.err(n, format!("<{}>: {degenerate}", n.name)))?;
+            let made = made.ok_or_else(|| self.err(n, format!("<{}>: {why}", n.name)))?;
             let key = format!("{prefix}{}", id.trimmed());
             if self.transforms.insert(key.clone(), made).is_some() {
                 return Err(self.err(n, format!("duplicate transformation '{key}'")));
@@ -304,13 +312,18 @@ impl Reader<'_> {
             return Ok(Transform::IDENTITY);
         };
         let mut acc = Transform::IDENTITY;
-        for name in list.trimmed().split_whitespace() {
+        for (i, name) in list.trimmed().split_whitespace().enumerate() {
             let t = self
                 .transforms
                 .get(name)
                 .ok_or_else(|| self.err(list, format!("<Transformations>: unknown transformation '{name}'")))?;
             // The first listed is applied first (README (ii), "Mesh/Transformations").
             acc = acc.then(t);
+            if !acc.is_finite() {
+                let names: Vec<&str> = list.trimmed().split_whitespace().take(i + 1).collect();
+                let msg = format!("<Transformations>: composing '{}' {OVERFLOWS}", names.join(" "));
+                return Err(self.err(list, msg));
+            }
         }
         Ok(acc)
     }
@@ -331,6 +344,24 @@ impl Reader<'_> {
         let c = self.req(n, name)?;
         let v = c.vec3(self.path)?;
         v.try_normalize().ok_or_else(|| self.err(c, format!("<{name}>: zero vector")))
+    }
+}
+
+/// What is wrong with a transform whose matrix or inverse has an entry beyond `f32`.
+const OVERFLOWS: &str = "overflows to infinity (an entry of the matrix or of its inverse is beyond the range of \
+                         32-bit floats)";
+
+/// Why [`Transform::from_mat4`] refuses `m`, whose entries are finite.
+fn why_singular(m: &Mat4) -> String {
+    let det = m.determinant();
+    if !det.is_finite() {
+        "the transform cannot be inverted: its determinant overflows to infinity (beyond the range of 32-bit \
+         floats)"
+            .to_string()
+    } else if det == 0.0 {
+        "the matrix is not invertible".to_string()
+    } else {
+        format!("the transform is too close to singular to invert: its determinant {det:e} is below 1e-30")
     }
 }
 
@@ -736,6 +767,42 @@ mod tests {
         let c = "<Transformations><Composite id=\"1\">0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1</Composite></Transformations>";
         let e = read_xml(c).unwrap_err();
         assert_eq!(e.to_string(), "t.xml:1:25: <Composite>: the matrix is not invertible");
+        // Factors that are not zero but whose determinant leaves the range of f32.
+        let e = read_xml("<Transformations><Scaling id=\"2\">1e30 1e30 1e30</Scaling></Transformations>").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Scaling>: the transform cannot be inverted: its determinant overflows to infinity (beyond \
+             the range of 32-bit floats)"
+        );
+        let e =
+            read_xml("<Transformations><Scaling id=\"2\">1e-11 1e-11 1e-11</Scaling></Transformations>").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.xml:1:25: <Scaling>: the transform is too close to singular to invert: its determinant 9.999999e-34 \
+             is below 1e-30"
+        );
+    }
+
+    #[test]
+    fn metu_composed_transformations_that_overflow_are_errors() {
+        let body = |list: &str| {
+            format!(
+                "{MATERIAL}<VertexData>0 0 0 1 0 0 0 1 0</VertexData><Transformations><Scaling id=\"1\">1e20 1 1\
+                 </Scaling><Scaling id=\"2\">1e-20 1 1</Scaling></Transformations><Objects><Mesh id=\"1\">\
+                 <Material>1</Material><Faces>1 2 3</Faces><Transformations>{list}</Transformations></Mesh>\
+                 </Objects>"
+            )
+        };
+        // Each factor is fine, and so is a product that comes back into range.
+        assert!(read_xml(&body("s1 s2 s1")).is_ok());
+        for (list, upto) in [("s1 s1 s2", "s1 s1"), ("s2 s2", "s2 s2")] {
+            let e = read_xml(&body(list)).unwrap_err().to_string();
+            let want = format!(
+                "<Transformations>: composing '{upto}' overflows to infinity (an entry of the matrix or of its \
+                 inverse is beyond the range of 32-bit floats)"
+            );
+            assert!(e.starts_with("t.xml:1:") && e.ends_with(&want), "{e}");
+        }
     }
 
     #[test]

@@ -148,6 +148,11 @@ impl Reader<'_> {
                 // Without resetTransform the instance moves its base from where the base put it.
                 if !p.reset {
                     inst.transform = base_transform.then(&inst.transform);
+                    if !inst.transform.is_finite() {
+                        let msg =
+                            format!("{}: its base's transform followed by its own {}", inst.name, super::OVERFLOWS);
+                        return Err(Error::input(inst.loc.clone(), msg));
+                    }
                 }
                 if !p.has_material {
                     inst.material = base_material;
