@@ -162,7 +162,18 @@ fn bench_ray_files_print_peerbench_lines_and_count_mismatches() {
     let sets: Vec<String> = stdout(&o).lines().filter(|l| l.starts_with("peer=")).map(|l| l.to_string()).collect();
     assert_eq!(sets.len(), 2, "{sets:?}");
     assert!(sets.iter().all(|l| l.contains(" set=diffuse ")), "{sets:?}");
+    // Read, a file without rays is bad input: it would time nothing.
+    std::fs::write(dir.join("primary.hits"), b"").unwrap();
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--runs", "1"], tmp.path());
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(3), "error: rays/primary.rays: the file holds no rays\n"));
     std::fs::write(dir.join("primary.rays"), &bytes).unwrap();
+    // A reference hit on a triangle the mesh lacks (it has 2).
+    std::fs::write(dir.join("primary.hits"), [hit_record(2.0, 1), hit_record(2.0, 2), hit_record(5.0, 1)].concat())
+        .unwrap();
+    let o = arbor(&["bench", "quad.off", "--ray-dir", "rays", "--runs", "1"], tmp.path());
+    let want = "error: rays/primary.hits: byte 12: hit 1: triangle 2 is not in the mesh (it has 2 triangles)\n";
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(3), want));
+    std::fs::write(dir.join("primary.hits"), &hits).unwrap();
 
     // A truncated ray file is bad input (exit 3) named with its byte offset; a missing one an I/O error.
     std::fs::write(dir.join("diffuse.rays"), &bytes[..40]).unwrap();

@@ -68,7 +68,7 @@ fn main() {
     );
 
     for set in ["primary", "diffuse"] {
-        let file = load_ray_set(Path::new(dir), set).unwrap_or_else(|e| {
+        let file = load_ray_set(Path::new(dir), set, mesh.len()).unwrap_or_else(|e| {
             eprintln!("{dir}: {e}");
             std::process::exit(1);
         });

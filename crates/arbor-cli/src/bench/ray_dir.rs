@@ -69,7 +69,7 @@ pub fn run(args: &BenchArgs, dir: &Path) -> Result<(), Failure> {
     let sets: Vec<RaySetFile> = ["primary", "diffuse"]
         .into_iter()
         .filter(|name| args.rays.has(name))
-        .map(|name| load_ray_set(dir, name))
+        .map(|name| load_ray_set(dir, name, mesh.len()))
         .collect::<Result<_, _>>()?;
     let batches: Vec<Batch> = sets
         .iter()

@@ -7,9 +7,14 @@
 //! little-endian `f32` `t` (`+inf` on a miss) and a `u32` triangle index (`0xFFFFFFFF` on a miss), the
 //! triangle index counting the mesh file's triangles after fan triangulation, as Arbor's loaders do.
 //!
-//! Files are checked before use: a length that is not a whole number of records, two files that
-//! disagree on the number of rays, or a `t_min` other than 0 (Arbor's queries cover `(0, t_max)`) are
-//! reported with the file and byte offset, never a panic.
+//! Files are checked before use, and every fault is reported with the file, the byte offset and the
+//! record's index, never a panic: a length that is not a whole number of records, a file without rays,
+//! two files that disagree on the number of rays; a ray with a `t_min` other than 0 (Arbor's queries
+//! cover `(0, t_max)`), a non-finite origin or direction, a zero direction, or a `t_max` that is not
+//! positive; a hit whose `t` is not positive and finite, or lies beyond its ray's `t_max`, or whose
+//! triangle is not in the mesh, and a miss that is not exactly `(+inf, 0xFFFFFFFF)`. Such rays and
+//! hits are no measurement: a NaN ray hits nothing in any structure, and a bad reference counts as a
+//! mismatch that is not one.
 
 use std::path::Path;
 
@@ -57,8 +62,8 @@ pub struct RaySetFile {
     pub hits: Vec<RefHit>,
 }
 
-/// Reads `DIR/NAME.rays` and `DIR/NAME.hits`.
-pub fn load_ray_set(dir: &Path, name: &str) -> Result<RaySetFile> {
+/// Reads `DIR/NAME.rays` and `DIR/NAME.hits`, for a mesh of `triangles` triangles.
+pub fn load_ray_set(dir: &Path, name: &str, triangles: usize) -> Result<RaySetFile> {
     let rays_path = dir.join(format!("{name}.rays"));
     let hits_path = dir.join(format!("{name}.hits"));
     let rays_bytes = crate::input::load_bytes(&rays_path)?;
@@ -70,6 +75,20 @@ pub fn load_ray_set(dir: &Path, name: &str) -> Result<RaySetFile> {
             Location::file(&hits_path),
             format!("{} hits for {} rays in {}", hits.len(), rays.len(), rays_path.display()),
         ));
+    }
+    for (i, (hit, ray)) in hits.iter().zip(&rays).enumerate() {
+        if !hit.is_hit() {
+            continue;
+        }
+        let at = |field: usize| Location::byte(&hits_path, (i * HIT_RECORD + field) as u64);
+        if hit.prim as usize >= triangles {
+            let msg = format!("hit {i}: triangle {} is not in the mesh (it has {triangles} triangles)", hit.prim);
+            return Err(Error::input(at(4), msg));
+        }
+        if hit.t > ray.t_max {
+            let msg = format!("hit {i}: t {} lies beyond its ray's t_max {}", hit.t, ray.t_max);
+            return Err(Error::input(at(0), msg));
+        }
     }
     Ok(RaySetFile { name: name.to_string(), rays, hits })
 }
@@ -92,28 +111,55 @@ fn whole_records(bytes: &[u8], record: usize, path: &Path) -> Result<usize> {
 /// Parses the bytes of a `.rays` file (`path` names it in errors).
 pub fn parse_rays(bytes: &[u8], path: &Path) -> Result<Vec<FileRay>> {
     let n = whole_records(bytes, RAY_RECORD, path)?;
+    if n == 0 {
+        return Err(Error::input(Location::file(path), "the file holds no rays"));
+    }
     let mut out = Vec::with_capacity(n);
     for (i, r) in bytes.chunks_exact(RAY_RECORD).enumerate() {
         let v: [f32; 8] = std::array::from_fn(|k| f32_at(r, 4 * k));
-        if v[3] != 0.0 {
-            return Err(Error::input(
-                Location::byte(path, (i * RAY_RECORD + 12) as u64),
-                format!("ray {i} has t_min {} (only 0 is supported: queries cover (0, t_max))", v[3]),
-            ));
+        let at = |field: usize| Location::byte(path, (i * RAY_RECORD + 4 * field) as u64);
+        let (origin, dir) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[4], v[5], v[6]));
+        let fault = if v[3] != 0.0 {
+            Some((3, format!("has t_min {} (only 0 is supported: queries cover (0, t_max))", v[3])))
+        } else if !origin.is_finite() {
+            Some((0, format!("has a non-finite origin {origin}")))
+        } else if !dir.is_finite() {
+            Some((4, format!("has a non-finite direction {dir}")))
+        } else if dir == Vec3::ZERO {
+            Some((4, "has a zero direction".to_string()))
+        } else if v[7].is_nan() || v[7] <= 0.0 {
+            Some((7, format!("has t_max {} (expected a positive number or +inf)", v[7])))
+        } else {
+            None
+        };
+        if let Some((field, what)) = fault {
+            return Err(Error::input(at(field), format!("ray {i} {what}")));
         }
-        let ray = Ray::new(Vec3::new(v[0], v[1], v[2]), Vec3::new(v[4], v[5], v[6]));
-        out.push(FileRay { ray, t_max: v[7] });
+        out.push(FileRay { ray: Ray::new(origin, dir), t_max: v[7] });
     }
     Ok(out)
 }
 
-/// Parses the bytes of a `.hits` file (`path` names it in errors).
+/// Parses the bytes of a `.hits` file (`path` names it in errors): each record a hit at a positive,
+/// finite `t`, or a miss, `(+inf, 0xFFFFFFFF)`.
 pub fn parse_hits(bytes: &[u8], path: &Path) -> Result<Vec<RefHit>> {
-    whole_records(bytes, HIT_RECORD, path)?;
-    Ok(bytes
-        .chunks_exact(HIT_RECORD)
-        .map(|r| RefHit { t: f32_at(r, 0), prim: u32::from_le_bytes([r[4], r[5], r[6], r[7]]) })
-        .collect())
+    let n = whole_records(bytes, HIT_RECORD, path)?;
+    let mut out = Vec::with_capacity(n);
+    for (i, r) in bytes.chunks_exact(HIT_RECORD).enumerate() {
+        let hit = RefHit { t: f32_at(r, 0), prim: u32::from_le_bytes([r[4], r[5], r[6], r[7]]) };
+        let is_miss = hit.prim == u32::MAX;
+        let fine = if is_miss { hit.t == f32::INFINITY } else { hit.t.is_finite() && hit.t > 0.0 };
+        if !fine {
+            let msg = if is_miss {
+                format!("hit {i}: a miss (triangle {}) must have t = +inf, not {}", u32::MAX, hit.t)
+            } else {
+                format!("hit {i}: triangle {} at t {} (a hit's t must be positive and finite)", hit.prim, hit.t)
+            };
+            return Err(Error::input(Location::byte(path, (i * HIT_RECORD) as u64), msg));
+        }
+        out.push(hit);
+    }
+    Ok(out)
 }
 
 /// True when a hit at `t` (or a miss, `None`) disagrees with the reference: one hits and the other
@@ -164,15 +210,81 @@ mod tests {
         assert!(e.contains("t_min 0.5") && e.contains("byte 12"), "{e}");
     }
 
+    fn hit_bytes(t: f32, prim: u32) -> Vec<u8> {
+        t.to_le_bytes().into_iter().chain(prim.to_le_bytes()).collect()
+    }
+
     #[test]
     fn ray_files_missing_or_mismatched_files_are_errors() {
         let dir = tempfile::tempdir().unwrap();
-        let e = load_ray_set(dir.path(), "primary").unwrap_err();
+        let e = load_ray_set(dir.path(), "primary", 1).unwrap_err();
         assert!(e.is_io() && e.to_string().contains("primary.rays"), "{e}");
         std::fs::write(dir.path().join("primary.rays"), ray_bytes([0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0])).unwrap();
-        std::fs::write(dir.path().join("primary.hits"), [0u8; 16]).unwrap();
-        let e = load_ray_set(dir.path(), "primary").unwrap_err().to_string();
+        let misses = [hit_bytes(f32::INFINITY, u32::MAX), hit_bytes(f32::INFINITY, u32::MAX)].concat();
+        std::fs::write(dir.path().join("primary.hits"), misses).unwrap();
+        let e = load_ray_set(dir.path(), "primary", 1).unwrap_err().to_string();
         assert!(e.contains("2 hits for 1 rays"), "{e}");
+    }
+
+    #[test]
+    fn ray_files_reject_empty_files_and_rays_that_trace_nothing() {
+        let p = Path::new("p.rays");
+        let e =
+            |v: [f32; 8]| parse_rays(&[ray_bytes([0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]), ray_bytes(v)].concat(), p);
+        assert_eq!(parse_rays(&[], p).unwrap_err().to_string(), "p.rays: the file holds no rays");
+        let nan = f32::NAN;
+        assert_eq!(
+            e([nan, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]).unwrap_err().to_string(),
+            "p.rays: byte 32: ray 1 has a non-finite origin [NaN, 0, 0]"
+        );
+        assert_eq!(
+            e([0.0, 0.0, 0.0, 0.0, 1.0, f32::INFINITY, 0.0, 1.0]).unwrap_err().to_string(),
+            "p.rays: byte 48: ray 1 has a non-finite direction [1, inf, 0]"
+        );
+        assert_eq!(
+            e([0.0, 0.0, 0.0, 0.0, 0.0, -0.0, 0.0, 1.0]).unwrap_err().to_string(),
+            "p.rays: byte 48: ray 1 has a zero direction"
+        );
+        for (t_max, shown) in [(nan, "NaN"), (0.0, "0"), (-1.0, "-1")] {
+            assert_eq!(
+                e([0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, t_max]).unwrap_err().to_string(),
+                format!("p.rays: byte 60: ray 1 has t_max {shown} (expected a positive number or +inf)")
+            );
+        }
+    }
+
+    #[test]
+    fn ray_files_reject_hits_out_of_range() {
+        let p = Path::new("p.hits");
+        let e = |t: f32, prim: u32| {
+            parse_hits(&[hit_bytes(2.0, 0), hit_bytes(t, prim)].concat(), p).unwrap_err().to_string()
+        };
+        let hit = "(a hit's t must be positive and finite)";
+        assert_eq!(e(f32::NAN, 3), format!("p.hits: byte 8: hit 1: triangle 3 at t NaN {hit}"));
+        assert_eq!(e(-2.0, 3), format!("p.hits: byte 8: hit 1: triangle 3 at t -2 {hit}"));
+        assert_eq!(e(0.0, 3), format!("p.hits: byte 8: hit 1: triangle 3 at t 0 {hit}"));
+        assert_eq!(e(f32::INFINITY, 3), format!("p.hits: byte 8: hit 1: triangle 3 at t inf {hit}"));
+        assert_eq!(e(2.0, u32::MAX), "p.hits: byte 8: hit 1: a miss (triangle 4294967295) must have t = +inf, not 2");
+
+        // Against the rays and the mesh: a triangle the mesh lacks, a hit beyond its ray's t_max.
+        let dir = tempfile::tempdir().unwrap();
+        let rays =
+            [ray_bytes([0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 5.0]), ray_bytes([0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 3.0])];
+        std::fs::write(dir.path().join("diffuse.rays"), rays.concat()).unwrap();
+        let load = |hits: &[Vec<u8>]| {
+            std::fs::write(dir.path().join("diffuse.hits"), hits.concat()).unwrap();
+            load_ray_set(dir.path(), "diffuse", 4).map(|s| s.hits.len()).map_err(|e| e.to_string())
+        };
+        let hits_path = dir.path().join("diffuse.hits");
+        assert_eq!(load(&[hit_bytes(2.0, 3), hit_bytes(3.0, 0)]), Ok(2));
+        assert_eq!(
+            load(&[hit_bytes(2.0, 3), hit_bytes(1.0, 4)]),
+            Err(format!("{}: byte 12: hit 1: triangle 4 is not in the mesh (it has 4 triangles)", hits_path.display()))
+        );
+        assert_eq!(
+            load(&[hit_bytes(2.0, 3), hit_bytes(3.5, 0)]),
+            Err(format!("{}: byte 8: hit 1: t 3.5 lies beyond its ray's t_max 3", hits_path.display()))
+        );
     }
 
     #[test]
