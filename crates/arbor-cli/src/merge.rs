@@ -14,7 +14,9 @@ pub struct MergeArgs {
     /// Partial EXR files written by `arbor render --tile/--sample-offset/--sample-count` (any order).
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
-    /// The merged image; the extension picks the format (.png, .ppm, .exr, .jpg, .jpeg).
+    /// The merged image; the extension picks the format (.png, .ppm, .exr, .hdr, .jpg, .jpeg). An .exr or
+    /// .hdr image gets its tone-mapped PNG beside it, which replaces a file of that name; the two are
+    /// written together or not at all.
     #[arg(short = 'o', long = "out", value_name = "IMAGE")]
     pub out: PathBuf,
     /// No summary line (`Saved: IMAGE` stays).

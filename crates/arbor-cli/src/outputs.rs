@@ -3,10 +3,11 @@
 //!
 //! `-o` names a folder (created if missing) into which every camera's image goes under the name the
 //! scene gives it, or, when it ends in an image extension, the one image of a scene with one camera (a
-//! scene with several is a usage error: `-o` then names a folder). Every target is checked: an
-//! extension Arbor writes, a folder that exists (images and partial EXRs may also name one that can be
-//! created, as their writers create it; `--stats-json` may not) and that accepts a new file (a probe file is created and removed at once, which also answers for root, for
-//! whom permission bits say nothing). Errors name the target file.
+//! scene with several is a usage error: `-o` then names a folder). Every target, and the PNG beside an
+//! HDR one, is checked: an extension Arbor writes, a folder that exists (images and partial EXRs may
+//! also name one that can be created, as their writers create it; `--stats-json` may not) and that
+//! accepts a new file (a probe file is created and removed at once, which also answers for root, for
+//! whom permission bits say nothing), and a name that is not a folder. Errors name the target file.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -41,7 +42,9 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
             )));
         }
         check_extension(out).map_err(Failure::Usage)?;
-        check_writable(out, true)?;
+        for file in files_written(out) {
+            check_writable(&file, true)?;
+        }
         return Ok(vec![out.to_path_buf()]);
     }
     let mut targets: Vec<PathBuf> = Vec::with_capacity(cameras.len());
@@ -65,7 +68,9 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
                 return Err(refuse(msg).into());
             }
         }
-        check_writable(&path, true)?;
+        for file in &files {
+            check_writable(file, true)?;
+        }
         written.extend(files.into_iter().map(|f| (f, cam.id.as_str())));
         targets.push(path);
     }

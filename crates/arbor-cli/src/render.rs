@@ -38,8 +38,10 @@ pub struct RenderArgs {
     /// Scene file (.xml or .json). Without one, renders the built-in example Cornell box.
     pub scene: Option<PathBuf>,
     /// Folder for the images (created if missing); each camera's file name comes from the scene. A name
-    /// ending in an image extension (.png, .ppm, .exr, .jpg, .jpeg) is the image of a one-camera scene.
-    /// For a slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
+    /// ending in an image extension (.png, .ppm, .exr, .hdr, .jpg, .jpeg) is the image of a one-camera
+    /// scene. An .exr or .hdr image gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a
+    /// file of that name; the two are written together or not at all. For a slice (--tile,
+    /// --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
     /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.

@@ -377,6 +377,31 @@ fn hardening_scene_images_stay_in_the_output_folder_and_apart() {
 }
 
 #[test]
+fn hardening_hdr_image_and_its_png_are_checked_together() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.exr")).unwrap();
+    // The PNG beside the EXR cannot be written (a folder has its name): refused before rendering, and
+    // the EXR is not written alone.
+    std::fs::create_dir(tmp.path().join("x.png")).unwrap();
+    let o = arbor(&["render", "s.xml", "-o", "x.exr"], tmp.path());
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), "error: x.png: cannot write it: it is a folder\n"));
+    assert!(o.stdout.is_empty(), "rendered before failing");
+    std::fs::create_dir_all(tmp.path().join("out/s.png")).unwrap();
+    let o = arbor(&["render", "s.xml", "-o", "out"], tmp.path());
+    let want = "error: out/s.png: cannot write it: it is a folder\n";
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), want));
+    assert_eq!(entries(tmp.path()), ["out", "s.xml", "x.png"]);
+    assert_eq!(entries(&tmp.path().join("out")), ["s.png"]);
+    // An older PNG of that name is replaced, as --help says.
+    std::fs::remove_dir(tmp.path().join("x.png")).unwrap();
+    std::fs::write(tmp.path().join("x.png"), b"older").unwrap();
+    let o = arbor(&["render", "-q", "s.xml", "-o", "x.exr"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(tmp.path().join("x.png")).unwrap().starts_with(b"\x89PNG"));
+    assert_eq!(entries(tmp.path()), ["out", "s.xml", "x.exr", "x.png"]);
+}
+
+#[test]
 fn hardening_short_render_prints_no_progress_to_a_log() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.png")).unwrap();

@@ -404,3 +404,32 @@ fn write_outputs_hdr_image_gets_a_tone_mapped_png_beside() {
     assert_eq!(write_outputs(&ldr, &film, Some(&tm)).unwrap(), vec![ldr.clone()]);
     assert_eq!(read_rgb8(&ldr).unwrap().2, tm.apply(&film).to_rgb8());
 }
+
+#[test]
+fn write_outputs_hdr_pair_is_written_whole_or_not_at_all() {
+    use arbor::image_io::write_outputs;
+    use arbor::tonemap::Tonemap;
+    let dir = tempfile::tempdir().unwrap();
+    let film = level_film(2, 2);
+    let (exr, png) = (dir.path().join("out.exr"), dir.path().join("out.png"));
+    // A folder holds the PNG's name: its rename fails after the EXR's has been made.
+    fs::create_dir(&png).unwrap();
+    let refused = format!("{}: Is a directory (os error 21)", png.display());
+    let err = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap_err();
+    assert_eq!(err.to_string(), refused);
+    assert_eq!(strays(dir.path(), &[]), ["out.png"], "a new EXR without its PNG, or a temporary file");
+    // An older EXR is given back its contents.
+    fs::write(&exr, b"older image").unwrap();
+    let err = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap_err();
+    assert_eq!(err.to_string(), refused);
+    assert_eq!(fs::read(&exr).unwrap(), b"older image");
+    assert_eq!(strays(dir.path(), &[]), ["out.exr", "out.png"]);
+    // Once the name is free, both files are replaced and nothing else is left.
+    fs::remove_dir(&png).unwrap();
+    fs::write(&png, b"older preview").unwrap();
+    let written = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap();
+    assert_eq!(written, [exr.clone(), png.clone()]);
+    assert_eq!(read_image(&exr).unwrap(), film);
+    assert_eq!(read_rgb8(&png).unwrap().2, Tonemap::PREVIEW.apply(&film).to_rgb8());
+    assert_eq!(strays(dir.path(), &[]), ["out.exr", "out.png"]);
+}

@@ -5,6 +5,11 @@
 //! one directory is atomic on POSIX and replaces the target on Windows, so readers see either the old image
 //! or the new one. On any failure the temporary file is removed, and the error names the target (the
 //! temporary file is an implementation detail the user never asked for).
+//!
+//! An image with a tone-mapped PNG beside it is one output: both files are written to temporary files
+//! before either is renamed, and should the second rename fail, the first target gets its previous
+//! contents back (kept meanwhile as a hard link, `.<name>.<pid>.<n>.old`) or is removed if it had none,
+//! so a failed run leaves the old pair or nothing, never a new image beside an old or missing PNG.
 
 use std::fs;
 use std::io::{Cursor, Write};
@@ -52,6 +57,11 @@ enum Rgb8 {
 /// The parent directory is created when missing. The write is atomic: on failure an existing file at
 /// `path` is left untouched and no temporary file remains.
 pub fn write_image(path: &Path, film: &Film) -> Result<()> {
+    write_atomic(path, &encoded(path, film)?)
+}
+
+/// The bytes of `film` in the format of `path`'s extension.
+fn encoded(path: &Path, film: &Film) -> Result<Vec<u8>> {
     let format = format_of(path)?;
     let expected = film.width as usize * film.height as usize;
     if film.pixels.len() != expected || expected == 0 {
@@ -63,8 +73,7 @@ pub fn write_image(path: &Path, film: &Film) -> Result<()> {
             film.pixels.len()
         )));
     }
-    let bytes = encode(film, format).map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
-    write_atomic(path, &bytes)
+    encode(film, format).map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))
 }
 
 fn format_of(path: &Path) -> Result<Format> {
@@ -155,16 +164,17 @@ pub fn tone_mapped_beside(path: &Path) -> PathBuf {
 
 /// Writes a camera's image: `film` as it is to `path`, except that with a `tonemap` an 8-bit format gets
 /// the tone-mapped film, and a high-dynamic-range one gets the film as it is plus the tone-mapped PNG
-/// beside it ([`tone_mapped_beside`]). Returns the files written, each written atomically.
+/// beside it ([`tone_mapped_beside`]), replacing a file of that name. Returns the files written: all of
+/// them, atomically, or none (see the module documentation).
 pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Result<Vec<PathBuf>> {
     let Some(tm) = tonemap else {
         write_image(path, film)?;
         return Ok(vec![path.to_path_buf()]);
     };
     if is_hdr_path(path) {
-        write_image(path, film)?;
         let png = tone_mapped_beside(path);
-        write_image(&png, &tm.apply(film))?;
+        let files = [(path.to_path_buf(), encoded(path, film)?), (png.clone(), encoded(&png, &tm.apply(film))?)];
+        write_atomic_set(&files)?;
         Ok(vec![path.to_path_buf(), png])
     } else {
         write_image(path, &tm.apply(film))?;
@@ -174,29 +184,112 @@ pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Res
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let (tmp, mut file) = create_temp(&dir, path)?;
-    let written = file.write_all(bytes).and_then(|()| file.sync_all()).map_err(|e| Error::io(path, e));
-    drop(file);
-    let renamed = written.and_then(|()| fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
-    if renamed.is_err() {
+    let tmp = write_temp(path, bytes)?;
+    fs::rename(&tmp, path).map_err(|e| {
         // Best effort: the original error is the one worth reporting.
         let _ = fs::remove_file(&tmp);
-    }
-    renamed
+        Error::io(path, e)
+    })
 }
 
-/// A new file named after the target, unique per process and call, so parallel writers never share one.
-fn create_temp(dir: &Path, target: &Path) -> Result<(PathBuf, fs::File)> {
+/// Writes every `(path, bytes)` of `files` atomically, or none of them: the renames start once every
+/// temporary file is on disk, and a failed rename undoes those before it.
+fn write_atomic_set(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    let mut temps = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        match write_temp(path, bytes) {
+            Ok(tmp) => temps.push(tmp),
+            Err(e) => {
+                remove_all(&temps);
+                return Err(e);
+            }
+        }
+    }
+    // Each renamed target and the link that keeps its previous contents, if it had any. The last
+    // rename has nothing after it to fail, so its target needs none.
+    let mut renamed: Vec<(&Path, Option<PathBuf>)> = Vec::with_capacity(files.len());
+    for (i, ((path, _), tmp)) in files.iter().zip(&temps).enumerate() {
+        let previous = if i + 1 < files.len() { keep_previous(path) } else { None };
+        if let Err(e) = fs::rename(tmp, path) {
+            // Best effort, as for one file: the rename's error is the one worth reporting.
+            remove_all(&temps[i..]);
+            remove_all(previous.as_slice());
+            for (done, previous) in renamed.into_iter().rev() {
+                let _ = match previous {
+                    Some(p) => fs::rename(p, done),
+                    None => fs::remove_file(done),
+                };
+            }
+            return Err(Error::io(path, e));
+        }
+        renamed.push((path, previous));
+    }
+    let kept: Vec<PathBuf> = renamed.into_iter().filter_map(|(_, p)| p).collect();
+    remove_all(&kept);
+    Ok(())
+}
+
+/// Removes the files, as far as possible: used on paths this module created, while another error is
+/// being reported or after success.
+fn remove_all(files: &[PathBuf]) {
+    for f in files {
+        let _ = fs::remove_file(f);
+    }
+}
+
+/// A hard link to the file (or symbolic link) at `path` under a fresh name beside it; `None` when there
+/// is none or the file system cannot link, in which case undoing a write removes the file instead.
+fn keep_previous(path: &Path) -> Option<PathBuf> {
+    if fs::symlink_metadata(path).ok()?.is_dir() {
+        return None;
+    }
+    loop {
+        let link = fresh_name(path, "old");
+        match fs::hard_link(path, &link) {
+            Ok(()) => return Some(link),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(_) => return None,
+        }
+    }
+}
+
+/// Writes `bytes` to a new temporary file beside `path` (creating the folder when missing) and flushes
+/// it to disk; errors name `path`.
+fn write_temp(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
+    let dir = folder_of(path);
+    fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let (tmp, mut file) = create_temp(path)?;
+    let written = file.write_all(bytes).and_then(|()| file.sync_all());
+    drop(file);
+    match written {
+        Ok(()) => Ok(tmp),
+        Err(e) => {
+            let _ = fs::remove_file(&tmp);
+            Err(Error::io(path, e))
+        }
+    }
+}
+
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// `.<name>.<pid>.<n>.<ext>` beside `target`, unique per process and call, so parallel writers never
+/// share one.
+fn fresh_name(target: &Path, ext: &str) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "image".to_string());
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    folder_of(target).join(format!(".{name}.{}.{n}.{ext}", std::process::id()))
+}
+
+/// A new temporary file named after the target.
+fn create_temp(target: &Path) -> Result<(PathBuf, fs::File)> {
     loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        let tmp = fresh_name(target, "tmp");
         match fs::OpenOptions::new().write(true).create_new(true).open(&tmp) {
             Ok(f) => return Ok((tmp, f)),
             // A leftover from a killed run with the same pid: take the next number.
