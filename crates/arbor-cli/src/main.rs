@@ -93,7 +93,12 @@ pub fn shown(path: &Option<PathBuf>) -> String {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let signals = match signals::Signals::install() {
+    let stopped = match cli.command {
+        Command::Render(_) => signals::RENDER_STOPPED,
+        Command::Merge(_) => signals::MERGE_STOPPED,
+        Command::Info(_) | Command::Bench(_) | Command::Diff(_) => signals::STOPPED,
+    };
+    let signals = match signals::Signals::install(stopped) {
         Ok(s) => s,
         Err(f) => return report(f),
     };
@@ -121,7 +126,7 @@ fn report(failure: Failure) -> ExitCode {
             ExitCode::from(2)
         }
         Failure::Interrupted(code) => {
-            eprintln!("{}", signals::MESSAGE);
+            eprintln!("{}", signals::STOPPED);
             ExitCode::from(code)
         }
         Failure::OutOfMemory(msg) => {

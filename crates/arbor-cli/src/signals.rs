@@ -25,8 +25,12 @@ use crate::Failure;
 /// How long a render may take to notice the cancel flag before the process exits anyway.
 const GRACE: Duration = Duration::from_millis(500);
 
-/// The line printed when a signal stops a command.
-pub const MESSAGE: &str = "interrupted: an image whose render was stopped is not written";
+/// The line printed when a signal stops `render`.
+pub const RENDER_STOPPED: &str = "interrupted: an image whose render was stopped is not written";
+/// The line printed when a signal stops `merge`, whose one write is atomic whenever the signal comes.
+pub const MERGE_STOPPED: &str = "interrupted: the merged image is written whole or not at all";
+/// The line printed when a signal stops a command that writes no file (`info`, `bench`, `diff`).
+pub const STOPPED: &str = "interrupted";
 
 /// What the command is doing, which decides what a signal does.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -43,6 +47,8 @@ struct State {
     stage: Stage,
     /// The exit code of the first signal received (130 or 143).
     code: Option<u8>,
+    /// The line printed on the way out: what the signal did to the command's output.
+    message: &'static str,
 }
 
 /// The command's side of the signal handling.
@@ -52,13 +58,14 @@ pub struct Signals {
 }
 
 impl Signals {
-    /// Starts the watcher; the command starts in [`Stage::Prepare`].
-    pub fn install() -> Result<Signals, Failure> {
+    /// Starts the watcher, which prints `message` when a signal stops the command ([`RENDER_STOPPED`],
+    /// [`MERGE_STOPPED`] or [`STOPPED`]); the command starts in [`Stage::Prepare`].
+    pub fn install(message: &'static str) -> Result<Signals, Failure> {
         let mut incoming = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
             .map_err(|e| arbor::Error::Invalid(format!("cannot install a signal handler: {e}")))?;
         let s = Signals {
             cancel: Arc::default(),
-            state: Arc::new(Mutex::new(State { stage: Stage::Prepare, code: None })),
+            state: Arc::new(Mutex::new(State { stage: Stage::Prepare, code: None, message })),
         };
         let (cancel, state) = (Arc::clone(&s.cancel), Arc::clone(&s.state));
         std::thread::Builder::new()
@@ -92,8 +99,8 @@ impl Signals {
 
     /// Ends the process for the signal `code` stands for, unless the watcher is already doing so.
     pub fn exit(&self, code: u8) -> ! {
-        let _held = lock(&self.state);
-        exit_now(code)
+        let held = lock(&self.state);
+        exit_now(code, held.message)
     }
 
     /// `Err(Interrupted)` once a signal came.
@@ -118,8 +125,8 @@ fn received(code: u8, cancel: &Arc<AtomicBool>, state: &Arc<Mutex<State>>) {
     let first = s.code.is_none();
     let code = *s.code.get_or_insert(code);
     match s.stage {
-        Stage::Prepare => exit_now(code),
-        Stage::Render if !first => exit_now(code),
+        Stage::Prepare => exit_now(code, s.message),
+        Stage::Render if !first => exit_now(code, s.message),
         Stage::Render => {
             drop(s);
             let state = Arc::clone(state);
@@ -127,7 +134,7 @@ fn received(code: u8, cancel: &Arc<AtomicBool>, state: &Arc<Mutex<State>>) {
                 std::thread::sleep(GRACE);
                 let s = lock(&state);
                 if s.stage != Stage::Write {
-                    exit_now(code);
+                    exit_now(code, s.message);
                 }
             });
         }
@@ -135,8 +142,9 @@ fn received(code: u8, cancel: &Arc<AtomicBool>, state: &Arc<Mutex<State>>) {
     }
 }
 
-/// Ends the process with `code`. Called with the stage locked, so no write can begin meanwhile.
-fn exit_now(code: u8) -> ! {
-    eprintln!("{MESSAGE}");
+/// Ends the process with `code`, saying `message`. Called with the stage locked, so no write can begin
+/// meanwhile.
+fn exit_now(code: u8, message: &str) -> ! {
+    eprintln!("{message}");
     std::process::exit(i32::from(code))
 }

@@ -431,7 +431,7 @@ fn hardening_signal_stops_bench_and_info_too() {
             .args(args)
             .current_dir(tmp.path())
             .stdout(Stdio::null())
-            .stderr(Stdio::null())
+            .stderr(Stdio::piped())
             .spawn()
             .unwrap();
         std::thread::sleep(Duration::from_millis(500));
@@ -450,5 +450,9 @@ fn hardening_signal_stops_bench_and_info_too() {
         };
         assert_eq!(status.code(), Some(143), "{args:?}");
         assert!(sent.elapsed() < Duration::from_secs(1), "{args:?} stopped {:?} after SIGTERM", sent.elapsed());
+        // Neither writes an image, so the message mentions none.
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert_eq!(err, "interrupted\n", "{args:?}");
     }
 }
