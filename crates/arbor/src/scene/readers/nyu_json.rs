@@ -77,6 +77,14 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
 fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc> {
     let focal = c.number("FocalLength")?;
     let fov = c.number("FieldOfView")?;
+    // The image plane must lie in front of the eye and its window must be neither empty nor turned over:
+    // either would render a wrong image without a word.
+    if focal <= 0.0 {
+        return Err(c.bad(c.required("FocalLength")?, &format!("{focal} must be positive")));
+    }
+    if !(fov > 0.0 && fov < std::f32::consts::PI) {
+        return Err(c.bad(c.required("FieldOfView")?, &format!("{fov} must be in (0, π) radians")));
+    }
     let top = focal * (fov / 2.0).tan();
     let right = top * WIDTH as f32 / HEIGHT as f32;
     let orthographic = match c.get("IsPerspective") {
@@ -317,5 +325,20 @@ mod tests {
         assert_eq!(e.to_string(), "s.json:2:14: \"Position\": expected an array of 3 numbers");
         let e = parse("{\"Objects\": []}", Path::new("s.json")).unwrap_err();
         assert_eq!(e.to_string(), "s.json:1:1: the scene: missing \"Camera\"");
+    }
+
+    #[test]
+    fn nyu_camera_needs_a_positive_focal_length_and_a_field_of_view_below_pi() {
+        let camera = |fov: &str, focal: &str| {
+            let text = format!(
+                "{{\"Camera\": {{\"Position\": [0, 0, 2], \"FieldOfView\": {fov}, \"FocalLength\": {focal}}}}}"
+            );
+            parse(&text, Path::new("s.json")).map(|_| ()).map_err(|e| e.to_string())
+        };
+        assert_eq!(camera("0.7854", "2"), Ok(()));
+        assert_eq!(camera("0.7854", "0"), Err("s.json:1:59: \"FocalLength\": 0 must be positive".into()));
+        assert_eq!(camera("0.7854", "-2"), Err("s.json:1:59: \"FocalLength\": -2 must be positive".into()));
+        assert_eq!(camera("0", "2"), Err("s.json:1:36: \"FieldOfView\": 0 must be in (0, π) radians".into()));
+        assert_eq!(camera("3.2", "2"), Err("s.json:1:36: \"FieldOfView\": 3.2 must be in (0, π) radians".into()));
     }
 }
