@@ -65,7 +65,7 @@ mod tests {
     /// A 24x16 JPEG of a gradient (several blocks, so the scan is long).
     fn jpeg() -> Vec<u8> {
         let (w, h) = (24u32, 16u32);
-        let px: Vec<u8> = (0..w * h).flat_map(|i| [(i * 7) as u8, (i * 3) as u8, (255 - i) as u8]).collect();
+        let px: Vec<u8> = (0..w * h).flat_map(|i| [(i * 7) as u8, (i * 3) as u8, (255 - i % 256) as u8]).collect();
         let mut out = Vec::new();
         JpegEncoder::new_with_quality(&mut out, 90).write_image(&px, w, h, ExtendedColorType::Rgb8).unwrap();
         out
