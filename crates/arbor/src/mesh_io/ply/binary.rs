@@ -146,6 +146,12 @@ pub(super) fn read_binary<E: Order>(
             _ => read_element(&mut src, e, role, nv, out)?,
         }
     }
+    // Bytes left over mean a count too small: the rest of the file would be dropped without a word.
+    if src.pos < bytes.len() {
+        let last = h.elements.last().map_or(String::new(), |e| format!(" (`{}`, {} claimed)", e.name, e.count));
+        let msg = format!("{} bytes after the data of the last element{last}", bytes.len() - src.pos);
+        return Err(Error::input(Location::byte(path, src.pos as u64), msg));
+    }
     Ok(())
 }
 

@@ -404,6 +404,29 @@ element face 1\nproperty list uchar int vertex_indices\n";
     }
 
     #[test]
+    fn ply_binary_bytes_after_the_last_element_are_an_error() {
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+element face 1\nproperty list uchar int vertex_indices\n";
+        for le in [true, false] {
+            let mut w = W::new(le, header);
+            for v in [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+                w.f32(v);
+            }
+            w.u8(3).i32(0).i32(1).i32(2);
+            let end = w.buf.len();
+            assert_eq!(parse(&w.buf).unwrap().len(), 1);
+            w.buf.extend_from_slice(b"junk");
+            let want = format!("m.ply: byte {end}: 4 bytes after the data of the last element (`face`, 1 claimed)");
+            assert_eq!(err(&w.buf), want);
+            // A second face that the count leaves out.
+            w.buf.truncate(end);
+            w.u8(3).i32(0).i32(2).i32(1);
+            let want = format!("m.ply: byte {end}: 13 bytes after the data of the last element (`face`, 1 claimed)");
+            assert_eq!(err(&w.buf), want);
+        }
+    }
+
+    #[test]
     fn ply_binary_truncated_vertices_name_byte_offset() {
         // A list longer than its minimum size eats the bytes the vertex needs.
         let header = "element material 1\nproperty list uchar float w\n\
