@@ -32,7 +32,7 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
     crate::outputs::check_writable(&args.out, true)?;
     // The image, and the PNG beside an HDR one, must not replace a part (they are read first, but a
     // failed or repeated merge would then have lost it).
-    for written in crate::outputs::files_written(&args.out) {
+    for written in crate::outputs::files_written(&args.out, true) {
         if let Some(part) = args.parts.iter().find(|p| same_file(p, &written)) {
             return Err(Failure::Usage(format!(
                 "-o {}: merge would write {}, which is the part {}",

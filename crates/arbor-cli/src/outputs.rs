@@ -30,8 +30,9 @@ pub fn names_a_file(out: &Path) -> bool {
     ext_of(out).is_some_and(|e| IMAGE_LIKE.contains(&e.as_str()))
 }
 
-/// The image file of each camera of `cameras`, checked.
-pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>, Failure> {
+/// The image file of each camera of `cameras`, checked, with the PNG beside each HDR image when
+/// `with_preview` (not for a debug view, which is written as it is).
+pub fn image_targets(out: &Path, cameras: &[&CameraDesc], with_preview: bool) -> Result<Vec<PathBuf>, Failure> {
     if names_a_file(out) {
         if cameras.len() != 1 {
             return Err(Failure::Usage(format!(
@@ -42,7 +43,7 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
             )));
         }
         check_extension(out).map_err(Failure::Usage)?;
-        for file in files_written(out) {
+        for file in files_written(out, with_preview) {
             check_writable(&file, true)?;
         }
         return Ok(vec![out.to_path_buf()]);
@@ -61,7 +62,7 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc]) -> Result<Vec<PathBuf>
         }
         let path = out.join(&cam.image_name);
         check_extension(&path).map_err(refuse)?;
-        let files = files_written(&path);
+        let files = files_written(&path, with_preview);
         for file in &files {
             if let Some((_, other)) = written.iter().find(|(f, _)| f == file) {
                 let msg = format!("{} would also be written by camera {other}", file.display());
@@ -120,10 +121,11 @@ pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
     }
 }
 
-/// The files that writing the image `path` makes: the image, and beside a high-dynamic-range one its
-/// tone-mapped PNG (every HDR image gets one: [`hdr_preview`]).
-pub fn files_written(path: &Path) -> Vec<PathBuf> {
-    let beside = arbor::image_io::is_hdr_path(path).then(|| arbor::image_io::tone_mapped_beside(path));
+/// The files that writing the image `path` makes: the image, and with `with_preview` beside a
+/// high-dynamic-range one its tone-mapped PNG (every rendered HDR image gets one: [`hdr_preview`]).
+pub fn files_written(path: &Path, with_preview: bool) -> Vec<PathBuf> {
+    let beside =
+        (with_preview && arbor::image_io::is_hdr_path(path)).then(|| arbor::image_io::tone_mapped_beside(path));
     std::iter::once(path.to_path_buf()).chain(beside).collect()
 }
 

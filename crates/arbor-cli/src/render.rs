@@ -195,7 +195,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         }
         None => {
             let cams: Vec<_> = cameras.iter().map(|&c| &desc.cameras[c]).collect();
-            crate::outputs::image_targets(&args.out, &cams)?
+            // A debug view is written as it is, with no tone-mapped PNG beside it.
+            crate::outputs::image_targets(&args.out, &cams, args.debug.is_none())?
         }
     };
     if let Some(file) = &args.stats_json {

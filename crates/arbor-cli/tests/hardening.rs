@@ -392,6 +392,12 @@ fn hardening_hdr_image_and_its_png_are_checked_together() {
     assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), want));
     assert_eq!(entries(tmp.path()), ["out", "s.xml", "x.png"]);
     assert_eq!(entries(&tmp.path().join("out")), ["s.png"]);
+    // A debug view is written without a PNG beside it, so the folder is in nobody's way.
+    let o = arbor(&["render", "-q", "s.xml", "-o", "x.exr", "--debug", "normal"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(entries(tmp.path()), ["out", "s.xml", "x.exr", "x.png"]);
+    assert!(tmp.path().join("x.png").is_dir());
+    std::fs::remove_file(tmp.path().join("x.exr")).unwrap();
     // An older PNG of that name is replaced, as --help says.
     std::fs::remove_dir(tmp.path().join("x.png")).unwrap();
     std::fs::write(tmp.path().join("x.png"), b"older").unwrap();
