@@ -173,8 +173,8 @@ pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Res
     };
     if is_hdr_path(path) {
         let png = tone_mapped_beside(path);
-        let files = [(path.to_path_buf(), encoded(path, film)?), (png.clone(), encoded(&png, &tm.apply(film))?)];
-        write_atomic_set(&files)?;
+        let (image, preview) = (encoded(path, film)?, encoded(&png, &tm.apply(film))?);
+        write_atomic_set(&[(path, &image), (&png, &preview)])?;
         Ok(vec![path.to_path_buf(), png])
     } else {
         write_image(path, &tm.apply(film))?;
@@ -184,17 +184,12 @@ pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Res
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = write_temp(path, bytes)?;
-    fs::rename(&tmp, path).map_err(|e| {
-        // Best effort: the original error is the one worth reporting.
-        let _ = fs::remove_file(&tmp);
-        Error::io(path, e)
-    })
+    write_atomic_set(&[(path, bytes)])
 }
 
 /// Writes every `(path, bytes)` of `files` atomically, or none of them: the renames start once every
 /// temporary file is on disk, and a failed rename undoes those before it.
-fn write_atomic_set(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+fn write_atomic_set(files: &[(&Path, &[u8])]) -> Result<()> {
     let mut temps = Vec::with_capacity(files.len());
     for (path, bytes) in files {
         match write_temp(path, bytes) {
