@@ -80,6 +80,8 @@ fn check<P: Primitives + 'static>(case: &str, prims: &P, probes: &[Probe]) -> Ca
         .collect();
     for &kind in AccelKind::ALL {
         let accel = build(kind, prims);
+        // `build` validates only in debug builds; the suite runs in release (README's one build).
+        accel.validate(prims).unwrap_or_else(|e| panic!("{kind} on {case}: invalid structure: {e}"));
         let is_reference = kind == AccelKind::Brute;
         let step = if is_reference { 16 } else { 1 };
         let mut single = Vec::with_capacity(probes.len());
@@ -813,7 +815,7 @@ const VARIANTS: &[(AccelKind, &[&str])] = &[
 ];
 const VARIANT_RAYS: usize = 10_000;
 
-/// [`check`] for every entry of [`VARIANTS`] (built from an `AccelConfig`, validated in debug builds).
+/// [`check`] for every entry of [`VARIANTS`] (built from an `AccelConfig`, then validated).
 fn check_variants(case: &str, tris: &[[Vec3; 3]], rng: &mut Rng) -> Cast {
     use arbor::accel::AccelConfig;
     let mesh = mesh_of(tris);
@@ -822,6 +824,7 @@ fn check_variants(case: &str, tris: &[[Vec3; 3]], rng: &mut Rng) -> Cast {
     for &(kind, params) in VARIANTS {
         let config = AccelConfig::from(kind).with_pairs(params.iter().copied()).unwrap();
         let accel = config.build_accel(&mesh).unwrap();
+        accel.validate(&mesh).unwrap_or_else(|e| panic!("{kind} {params:?} on {case}: invalid structure: {e}"));
         for p in &probes {
             let (got, want) = (accel.intersect(&mesh, &p.ray, p.t_max), brute.intersect(&mesh, &p.ray, p.t_max));
             assert!(same_hit(got, want), "{kind} {params:?} on {case}: {p:?} hit {got:?}, brute force {want:?}");

@@ -30,8 +30,27 @@ fn shared_dir(var: &str, name: &str) -> Option<PathBuf> {
     if std::env::var("CI").is_ok_and(|v| v == "true") {
         panic!("{msg}: required under CI");
     }
-    eprintln!("SKIPPED: {msg}");
+    say_not_checked(var, &msg);
     None
+}
+
+/// Tells the user, once per test program and past the test harness's capture (which swallows `eprintln!`
+/// of a passing test), that the tests which need the shared folder checked nothing.
+fn say_not_checked(var: &str, msg: &str) {
+    use std::io::Write;
+    static SAID: std::sync::Once = std::sync::Once::new();
+    SAID.call_once(|| {
+        // The test program's name without the hash cargo appends (`reference_scenes-0123abcd...`).
+        let path = std::env::args().next().unwrap_or_default();
+        let file = Path::new(&path).file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+        let program = file.rsplit_once('-').map_or(file.as_str(), |(name, _)| name);
+        // Straight to the stream, not `eprintln!`: libtest captures only the print macros.
+        let _ = writeln!(
+            std::io::stderr().lock(),
+            "\nNOT CHECKED ({program}): {msg}. The tests that need it pass without checking anything; \
+             put the shared folder beside the checkout or point {var} at it (CI=true makes its absence fail).\n"
+        );
+    });
 }
 
 /// Every file with extension `ext` below `dir`, sorted (none when `dir` cannot be read).
