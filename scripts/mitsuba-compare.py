@@ -287,10 +287,6 @@ def arbor_missing(arbor, integrator, path_options):
     return None
 
 
-# Arbor's EXR holds the radiance times the scene's radiance scale, 1/255 for the course's files.
-ARBOR_UNIT = 255.0
-
-
 def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0, sampler=None):
     """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed."""
     stats = Path(str(out) + ".stats.json")
@@ -308,7 +304,7 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
               (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
         return None
     render_ms = json.loads(stats.read_text())["images"][0]["render_ms"]
-    return read_exr(out) * ARBOR_UNIT, render_ms / 1e3
+    return read_exr(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
 
 def read_exr(path):
@@ -345,14 +341,15 @@ def references(args, path, camera_id, tag, arbor_ok):
         img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1)
         write_exr(mitsuba_file, img)
     refs["Mitsuba"] = read_exr(mitsuba_file)
-    arbor_file = args.cache / f"{tag}_arbor_{args.arbor_path_options or 'scene'}_{args.ref_spp}spp.exr"
+    # "radiance": Arbor's EXRs hold radiance in the scene's units (older caches held it times 1/255).
+    arbor_file = args.cache / f"{tag}_arbor_{args.arbor_path_options or 'scene'}_{args.ref_spp}spp_radiance.exr"
     refs["Arbor"] = None
     if arbor_ok and not arbor_file.exists():
         print(f"  rendering the Arbor reference ({args.ref_spp} spp) ...", flush=True)
         render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options, path, camera_id, args.ref_spp,
                      max(args.threads), arbor_file, seed=1)
     if arbor_ok and arbor_file.exists():
-        refs["Arbor"] = read_exr(arbor_file) * ARBOR_UNIT
+        refs["Arbor"] = read_exr(arbor_file)
     return refs
 
 

@@ -1,19 +1,29 @@
 //! `arbor diff`: compares an image with a reference the way the reference-image tests do: pixel by pixel,
 //! or, for a render of random samples whose noise cannot match pixel for pixel, by the means of KxK-pixel
-//! blocks (`--block K`). Both print the bias, the mean signed difference per channel.
+//! blocks (`--block K`), or against the noise that a second seed's render measures (`--noise`). Both
+//! print the bias, the mean signed difference per channel. High-dynamic-range images (EXR, HDR: radiance)
+//! are compared in display levels under one curve their reference fixes (`arbor::image_io::levels`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use arbor::image_io::metrics::{compare_blocks_files, compare_files};
-use arbor::image_io::noisy::compare_noisy_rgb8;
+use arbor::film::Film;
+use arbor::image_io::levels::{BlockLevels, DisplayCurve};
+use arbor::image_io::metrics::{compare_block_levels, compare_blocks_rgb8, compare_rgb8, BlockComparison, Comparison};
+use arbor::image_io::noisy::{compare_noisy, compare_noisy_rgb8};
+use arbor::image_io::{is_hdr_path, read_image, read_rgb8};
 use clap::Args;
 
 use crate::Failure;
 
+/// Block side of `--noise` without `--block`, and of the hint after a failed pixel-by-pixel diff.
+const NOISE_BLOCK: u32 = 16;
+
 /// Arguments of `arbor diff`.
 #[derive(Args)]
 pub struct DiffArgs {
-    /// The reference image.
+    /// The reference image. An EXR or HDR reference (radiance) fixes one display curve (Reinhard's global
+    /// operator at key 0.18 of its log-average luminance, gamma 2.2) under which both images are compared
+    /// in 8-bit levels; IMAGE must then be EXR or HDR too.
     pub reference: PathBuf,
     /// The image to check.
     pub image: PathBuf,
@@ -24,15 +34,16 @@ pub struct DiffArgs {
     #[arg(long, default_value_t = 0.5, value_parser = parse_percent)]
     pub max_off: f64,
     /// Compare the means of KxK-pixel blocks instead of pixels, for noisy renders (blocks at the right and
-    /// bottom edges are averaged over the pixels they have).
+    /// bottom edges are averaged over the pixels they have; HDR blocks are averaged in radiance, then
+    /// put through the curve).
     #[arg(long, value_name = "K", value_parser = parse_block)]
     pub block: Option<u32>,
-    /// For a noisy (path-traced) reference: two renders at the reference's samples with different seeds.
-    /// IMAGE is then a render at four times the samples, and it passes when, on the block means (--block,
-    /// default 16), it is no farther from the reference than the two seeds are from each other plus 1
-    /// level, with every channel's mean signed difference within 2 levels.
-    #[arg(long, num_args = 2, value_names = ["SEED_A", "SEED_B"])]
-    pub noise: Option<Vec<PathBuf>>,
+    /// For a noisy (path-traced) reference: the same render as IMAGE with another --seed, both at the
+    /// reference's samples. IMAGE passes when, on the block means (--block, default 16), it is no farther
+    /// from the reference than from this second seed plus 1 level, with every channel's mean signed
+    /// difference within 2 levels. --threshold and --max-off do not apply.
+    #[arg(long, value_name = "IMAGE_OTHER_SEED")]
+    pub noise: Option<PathBuf>,
 }
 
 /// Parses `--max-off`: a percentage from 0 to 100 (a NaN limit would pass every image).
@@ -53,33 +64,132 @@ fn parse_block(s: &str) -> Result<u32, String> {
     }
 }
 
+/// The images of one comparison, read alike: 8-bit, or radiance for HDR ones.
+enum Images {
+    Rgb8 { width: u32, height: u32, reference: Vec<u8>, images: Vec<Vec<u8>> },
+    Hdr { reference: Film, images: Vec<Film> },
+}
+
+/// Reads the reference and `images`, all 8-bit or all HDR, all of one size.
+fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
+    let hdr = is_hdr_path(reference);
+    for path in images {
+        if is_hdr_path(path) != hdr {
+            let (what, other) = if hdr { ("an HDR", "an 8-bit") } else { ("an 8-bit", "an HDR") };
+            return Err(Failure::Usage(format!(
+                "{} is {other} image but the reference {} is {what} one: compare radiance with radiance \
+                 (.exr, .hdr) or 8-bit images with 8-bit ones",
+                path.display(),
+                reference.display()
+            )));
+        }
+    }
+    let size_check = |path: &Path, got: (u32, u32), want: (u32, u32)| {
+        if got == want {
+            return Ok(());
+        }
+        let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
+        Err(Failure::from(arbor::Error::Invalid(msg)))
+    };
+    if hdr {
+        let reference = read_image(reference)?;
+        let mut films = Vec::new();
+        for path in images {
+            let film = read_image(path)?;
+            size_check(path, (film.width, film.height), (reference.width, reference.height))?;
+            films.push(film);
+        }
+        return Ok(Images::Hdr { reference, images: films });
+    }
+    let (width, height, reference) = read_rgb8(reference)?;
+    let mut rgbs = Vec::new();
+    for path in images {
+        let (w, h, px) = read_rgb8(path)?;
+        size_check(path, (w, h), (width, height))?;
+        rgbs.push(px);
+    }
+    Ok(Images::Rgb8 { width, height, reference, images: rgbs })
+}
+
+impl Images {
+    /// The first image against the reference, pixel by pixel (HDR ones in the curve's 8-bit levels).
+    fn pixels(&self, threshold: u8) -> Comparison {
+        match self {
+            Images::Rgb8 { width, height, reference, images } => {
+                compare_rgb8(reference, &images[0], *width, *height, threshold)
+            }
+            Images::Hdr { reference, images } => {
+                let curve = DisplayCurve::of_reference(reference);
+                let (w, h) = (reference.width, reference.height);
+                compare_rgb8(&curve.rgb8(reference), &curve.rgb8(&images[0]), w, h, threshold)
+            }
+        }
+    }
+
+    /// Every image's `k` x `k` block means in levels, the reference's first.
+    fn block_levels(&self, k: u32) -> Vec<BlockLevels> {
+        match self {
+            Images::Rgb8 { width, height, reference, images } => std::iter::once(reference)
+                .chain(images)
+                .map(|px| BlockLevels::of_rgb8(px, *width, *height, k))
+                .collect(),
+            Images::Hdr { reference, images } => {
+                let curve = DisplayCurve::of_reference(reference);
+                std::iter::once(reference).chain(images).map(|f| BlockLevels::of_film(f, k, &curve)).collect()
+            }
+        }
+    }
+
+    /// The first image against the reference, block by block.
+    fn blocks(&self, k: u32, threshold: u8) -> BlockComparison {
+        match self {
+            Images::Rgb8 { width, height, reference, images } => {
+                compare_blocks_rgb8(reference, &images[0], *width, *height, k, threshold)
+            }
+            Images::Hdr { reference, .. } => {
+                let levels = self.block_levels(k);
+                compare_block_levels(&levels[0], &levels[1], reference.width, reference.height, threshold)
+            }
+        }
+    }
+}
+
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
-    if let Some(seeds) = &args.noise {
-        let (w, h, reference) = arbor::image_io::read_rgb8(&args.reference)?;
-        let mut images = Vec::new();
-        for path in [&args.image, &seeds[0], &seeds[1]] {
-            let (pw, ph, px) = arbor::image_io::read_rgb8(path)?;
-            if (pw, ph) != (w, h) {
-                let msg = format!("{} is {pw}x{ph} but the reference is {w}x{h}", path.display());
-                return Err(arbor::Error::Invalid(msg).into());
+    let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
+    let images = read_all(&args.reference, &paths)?;
+    if matches!(images, Images::Hdr { .. }) {
+        say!(
+            "HDR images: compared in 8-bit levels under the reference's curve (key 0.18 of its log-average, gamma 2.2)"
+        );
+    }
+    if args.noise.is_some() {
+        let c = match &images {
+            Images::Rgb8 { width, height, reference, images } => compare_noisy_rgb8(
+                reference,
+                &images[0],
+                &images[1],
+                *width,
+                *height,
+                args.block.unwrap_or(NOISE_BLOCK),
+            ),
+            Images::Hdr { .. } => {
+                let levels = images.block_levels(args.block.unwrap_or(NOISE_BLOCK));
+                compare_noisy(&levels[0], &levels[1], &levels[2])
             }
-            images.push(px);
-        }
-        let (image, a, b) = (&images[0], &images[1], &images[2]);
-        let c = compare_noisy_rgb8(&reference, image, a, b, w, h, args.block.unwrap_or(16));
+        };
         say!("{}", c.summary());
         return if c.passes() { Ok(()) } else { Err(Failure::TooDifferent) };
     }
     let (share_off, what) = match args.block {
         None => {
-            let c = compare_files(&args.reference, &args.image, args.threshold)?;
+            let c = images.pixels(args.threshold);
             say!("{}", c.summary());
             say!("{}", c.bias_summary());
             (c.share_off, "pixels".to_string())
         }
         Some(k) => {
-            let c = compare_blocks_files(&args.reference, &args.image, k, args.threshold)?;
+            let c = images.blocks(k, args.threshold);
             say!("{}", c.summary());
             say!("{}", c.bias_summary());
             (c.share_off, format!("blocks of {k}x{k} pixels"))
@@ -93,6 +203,17 @@ pub fn run(args: DiffArgs) -> Result<(), Failure> {
         args.threshold,
         args.max_off
     );
+    if failed && args.block.is_none() {
+        // A render of random samples fails a pixel-by-pixel diff through its noise alone.
+        let b = images.blocks(NOISE_BLOCK, args.threshold);
+        say!(
+            "hint: {:.3}% of its {k}x{k}-pixel blocks are off; if the image is a render of random samples \
+             (path tracing, soft shadows, glossy reflections), compare block means (--block {k}) or measure \
+             the noise with a second seed's render (--noise IMAGE_OTHER_SEED)",
+            b.share_off * 100.0,
+            k = NOISE_BLOCK
+        );
+    }
     if failed {
         return Err(Failure::TooDifferent);
     }

@@ -15,7 +15,7 @@ pub struct MergeArgs {
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
     /// The merged image; the extension picks the format (.png, .ppm, .exr, .hdr, .jpg, .jpeg). An .exr or
-    /// .hdr image gets its tone-mapped PNG beside it, which replaces a file of that name; the two are
+    /// .hdr image holds radiance in the scene's units and gets its tone-mapped PNG beside it, which replaces a file of that name; the two are
     /// written together or not at all.
     #[arg(short = 'o', long = "out", value_name = "IMAGE")]
     pub out: PathBuf,
@@ -52,7 +52,8 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
     let first = &parts[0].1;
     let tonemap = first.tonemap.or_else(|| crate::outputs::hdr_preview(&args.out, first.sums.scale));
     signals.enter(crate::signals::Stage::Render);
-    let written = signals.writing(|| arbor::image_io::write_outputs(&args.out, &film, tonemap.as_ref()))?;
+    let written =
+        signals.writing(|| arbor::image_io::write_outputs(&args.out, &film, first.sums.scale, tonemap.as_ref()))?;
     signals.check()?;
     if !args.quiet {
         let spp = parts.first().map_or(0, |(_, p)| p.sums.spp);

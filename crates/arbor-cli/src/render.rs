@@ -39,8 +39,8 @@ pub struct RenderArgs {
     pub scene: Option<PathBuf>,
     /// Folder for the images (created if missing); each camera's file name comes from the scene. A name
     /// ending in an image extension (.png, .ppm, .exr, .hdr, .jpg, .jpeg) is the image of a one-camera
-    /// scene. An .exr or .hdr image gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a
-    /// file of that name; the two are written together or not at all. For a slice (--tile,
+    /// scene. An .exr or .hdr image holds radiance in the scene's units (255 is an 8-bit image's white in
+    /// METU files) and gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a file of that name; the two are written together or not at all. For a slice (--tile,
     /// --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
@@ -262,12 +262,13 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 bar.finish();
                 // A signal during the render leaves an incomplete film: never written.
                 signals.check()?;
-                let tonemap = if args.debug.is_some() {
-                    None
+                let (tonemap, unit) = if args.debug.is_some() {
+                    (None, 1.0)
                 } else {
-                    tonemap.or_else(|| hdr_preview(&target, scene.radiance_scale))
+                    (tonemap.or_else(|| hdr_preview(&target, scene.radiance_scale)), scene.radiance_scale)
                 };
-                let written = signals.writing(|| arbor::image_io::write_outputs(&target, &film, tonemap.as_ref()))?;
+                let written =
+                    signals.writing(|| arbor::image_io::write_outputs(&target, &film, unit, tonemap.as_ref()))?;
                 extra = written.into_iter().filter(|p| *p != target).collect();
                 (target, stats, window)
             }

@@ -226,7 +226,9 @@ fn catalogue() -> Vec<Row> {
     cmd(&["diff", "tex.png", "truncated.png"], 3, "error: truncated.png: cannot decode image: unexpected end of file (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.ppm"], 3, "error: truncated.ppm: cannot decode image: unexpected end of file (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.jpg"], 3, "error: truncated.jpg: cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)\n"),
-    cmd(&["diff", "tex.png", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: Format error decoding OpenExr: invalid: reference to missing bytes\n"),
+    cmd(&["diff", "truncated.exr", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: Format error decoding OpenExr: invalid: reference to missing bytes\n"),
+    // Radiance (EXR, HDR) against 8-bit values: refused before either is read.
+    cmd(&["diff", "tex.png", "truncated.exr"], 2, "error: truncated.exr is an HDR image but the reference tex.png is an 8-bit one: compare radiance with radiance (.exr, .hdr) or 8-bit images with 8-bit ones\n"),
     cmd(&["diff", "tex.png", "no_such_image.png"], 4, "error: no_such_image.png: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),

@@ -113,9 +113,10 @@ fn cli_hdr_image_without_a_tonemap_gets_the_course_tone_mapping_beside_it() {
     let o = arbor(&["render", "-q", scene.to_str().unwrap()], tmp.path());
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stdout(&o), "Saved: ./tiny.exr\nSaved: ./tiny.png\n");
+    // The EXR holds radiance in the scene's units (a METU file's 255 is white): the PNG is its tone
+    // mapping with one unit of radiance worth 1.
     let hdr = arbor::image_io::read_image(&tmp.path().join("tiny.exr")).unwrap();
-    let expected =
-        (hdr.width, hdr.height, arbor::tonemap::Tonemap::PREVIEW.in_units(1.0 / 255.0).apply(&hdr).to_rgb8());
+    let expected = (hdr.width, hdr.height, arbor::tonemap::Tonemap::PREVIEW.apply(&hdr).to_rgb8());
     assert_eq!(arbor::image_io::read_rgb8(&tmp.path().join("tiny.png")).unwrap(), expected);
     // A debug view is written as it is, alone.
     let debug = arbor(&["render", "-q", scene.to_str().unwrap(), "--debug", "normal", "-o", "d"], tmp.path());
@@ -222,6 +223,11 @@ OK: 0.000% of pixels off by more than 8 levels (limit 0.5%)
     assert!(stdout(&differ).contains("PSNR"), "{}", stdout(&differ));
 }
 
+/// What a failed pixel-by-pixel diff says after its verdict when its 16x16 blocks agree.
+const HINT: &str = "hint: 0.000% of its 16x16-pixel blocks are off; if the image is a render of random samples \
+                    (path tracing, soft shadows, glossy reflections), compare block means (--block 16) or measure \
+                    the noise with a second seed's render (--noise IMAGE_OTHER_SEED)\n";
+
 /// Writes a binary PPM of `width` x `height` pixels whose pixel (x, y) is `f(x, y)`.
 fn ppm(dir: &Path, name: &str, width: u32, height: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
     let mut bytes = format!("P6\n{width} {height}\n255\n").into_bytes();
@@ -240,7 +246,7 @@ fn cli_diff_blocks_pass_noise_that_pixels_fail() {
     let o = arbor(&["diff", "ref.ppm", "noisy.ppm"], tmp.path());
     let want = format!(
         "PSNR 22.09 dB, RMSE 20.042 levels, 8 of 8 pixels off (100.000%), max diff 22\n{bias}\
-         FAIL: 100.000% of pixels off by more than 8 levels (limit 0.5%)\n"
+         FAIL: 100.000% of pixels off by more than 8 levels (limit 0.5%)\n{HINT}"
     );
     assert_eq!((o.status.code(), stdout(&o), stderr(&o)), (Some(1), want, String::new()));
     let o = arbor(&["diff", "ref.ppm", "noisy.ppm", "--block", "2"], tmp.path());
@@ -281,22 +287,62 @@ bias (image minus reference): R +0.000, G +2.400, B +0.000 levels
 }
 
 #[test]
-fn cli_diff_noise_judges_a_converged_render_by_the_seed_noise() {
+fn cli_diff_noise_judges_a_render_by_its_second_seed() {
     let tmp = tempfile::tempdir().unwrap();
-    // Reference 100; two seeds 4 levels either side of it; a converged render 1 level off, then 5.
+    // Reference 100; a render 1 level off (then 9 in blue), its second seed 4 levels above it.
     ppm(tmp.path(), "ref.ppm", 4, 4, |_, _| [100; 3]);
-    ppm(tmp.path(), "a.ppm", 4, 4, |_, _| [104; 3]);
-    ppm(tmp.path(), "b.ppm", 4, 4, |_, _| [96; 3]);
     ppm(tmp.path(), "good.ppm", 4, 4, |_, _| [101, 100, 99]);
+    ppm(tmp.path(), "good_seed2.ppm", 4, 4, |_, _| [105, 104, 103]);
     ppm(tmp.path(), "far.ppm", 4, 4, |_, _| [100, 100, 109]);
-    let o = arbor(&["diff", "ref.ppm", "good.ppm", "--noise", "a.ppm", "b.ppm", "--block", "2"], tmp.path());
-    let want = "2x2 blocks: converged vs reference 0.67 levels, seed vs seed 8.00 (limit 9.00); bias +1.00 +0.00 \
+    ppm(tmp.path(), "far_seed2.ppm", 4, 4, |_, _| [104, 104, 113]);
+    let o = arbor(&["diff", "ref.ppm", "good.ppm", "--noise", "good_seed2.ppm", "--block", "2"], tmp.path());
+    let want = "2x2 blocks: render vs reference 0.67 levels, seed vs seed 4.00 (limit 5.00); bias +1.00 +0.00 \
                 -1.00 (limit ±2): OK\n";
     assert_eq!((o.status.code(), stdout(&o)), (Some(0), want.to_string()));
-    let o = arbor(&["diff", "ref.ppm", "far.ppm", "--noise", "a.ppm", "b.ppm"], tmp.path());
-    let want = "16x16 blocks: converged vs reference 3.00 levels, seed vs seed 8.00 (limit 9.00); bias +0.00 +0.00 \
+    let o = arbor(&["diff", "ref.ppm", "far.ppm", "--noise", "far_seed2.ppm"], tmp.path());
+    let want = "16x16 blocks: render vs reference 3.00 levels, seed vs seed 4.00 (limit 5.00); bias +0.00 +0.00 \
                 +9.00 (limit ±2): FAIL\n";
     assert_eq!((o.status.code(), stdout(&o)), (Some(1), want.to_string()));
+}
+
+/// Writes an EXR of radiance `f(x, y)` (grey) of `width` x `height` pixels.
+fn exr(dir: &Path, name: &str, width: u32, height: u32, f: impl Fn(u32, u32) -> f32) {
+    let pixels =
+        (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| arbor::math::Color::splat(f(x, y)));
+    let film = arbor::film::Film { width, height, pixels: pixels.collect() };
+    arbor::image_io::write_image(&dir.join(name), &film).unwrap();
+}
+
+#[test]
+fn cli_diff_hdr_images_in_the_reference_curve() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Radiance far above 1 (a METU scene's units): an 8-bit reading would clip all of it to white.
+    exr(tmp.path(), "ref.exr", 4, 4, |x, _| 200.0 + 100.0 * x as f32);
+    exr(tmp.path(), "same.exr", 4, 4, |x, _| 200.0 + 100.0 * x as f32);
+    exr(tmp.path(), "double.exr", 4, 4, |x, _| 400.0 + 200.0 * x as f32);
+    // Noise of +-50% that cancels in each 2x2 block.
+    exr(tmp.path(), "noisy.exr", 4, 4, |x, y| {
+        (200.0 + 100.0 * (x - x % 2) as f32 + 50.0) * if (x + y) % 2 == 0 { 1.5 } else { 0.5 }
+    });
+    let curve =
+        "HDR images: compared in 8-bit levels under the reference's curve (key 0.18 of its log-average, gamma 2.2)\n";
+    let o = arbor(&["diff", "ref.exr", "same.exr"], tmp.path());
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert!(stdout(&o).starts_with(curve) && stdout(&o).contains("PSNR inf"), "{}", stdout(&o));
+    // Twice the radiance: the reference's curve shows it brighter (its own curve would not).
+    let o = arbor(&["diff", "ref.exr", "double.exr"], tmp.path());
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(stdout(&o).contains("16 of 16 pixels off"), "{}", stdout(&o));
+    // Blocks average radiance before the curve: the noise is gone.
+    let o = arbor(&["diff", "ref.exr", "noisy.exr", "--block", "2"], tmp.path());
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert!(stdout(&o).contains("0 of 4 blocks of 2x2 pixels off"), "{}", stdout(&o));
+    // Radiance against 8-bit values compares nothing meaningful: a usage error.
+    ppm(tmp.path(), "ldr.ppm", 4, 4, |_, _| [100; 3]);
+    let o = arbor(&["diff", "ref.exr", "ldr.ppm"], tmp.path());
+    let want = "error: ldr.ppm is an 8-bit image but the reference ref.exr is an HDR one: compare radiance with \
+                radiance (.exr, .hdr) or 8-bit images with 8-bit ones\n";
+    assert_eq!((o.status.code(), stderr(&o)), (Some(2), want.to_string()));
 }
 
 #[test]

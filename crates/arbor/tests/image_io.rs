@@ -386,7 +386,7 @@ fn write_outputs_hdr_image_gets_a_tone_mapped_png_beside() {
     let tm = Tonemap::PREVIEW;
     for ext in ["exr", "hdr"] {
         let path = dir.path().join(format!("out.{ext}"));
-        let written = write_outputs(&path, &film, Some(&tm)).unwrap();
+        let written = write_outputs(&path, &film, 1.0, Some(&tm)).unwrap();
         assert_eq!(written, vec![path.clone(), dir.path().join("out.png")]);
         let back = read_image(&path).unwrap();
         for (a, b) in back.pixels.iter().zip(&film.pixels) {
@@ -398,11 +398,31 @@ fn write_outputs_hdr_image_gets_a_tone_mapped_png_beside() {
     }
     // Without a tone mapping, only the image asked for; an 8-bit one with it gets the mapped values.
     let plain = dir.path().join("plain.exr");
-    assert_eq!(write_outputs(&plain, &film, None).unwrap(), vec![plain.clone()]);
+    assert_eq!(write_outputs(&plain, &film, 1.0, None).unwrap(), vec![plain.clone()]);
     assert!(!dir.path().join("plain.png").exists());
     let ldr = dir.path().join("ldr.png");
-    assert_eq!(write_outputs(&ldr, &film, Some(&tm)).unwrap(), vec![ldr.clone()]);
+    assert_eq!(write_outputs(&ldr, &film, 1.0, Some(&tm)).unwrap(), vec![ldr.clone()]);
     assert_eq!(read_rgb8(&ldr).unwrap().2, tm.apply(&film).to_rgb8());
+}
+
+#[test]
+fn write_outputs_hdr_images_hold_radiance_in_the_scene_units() {
+    use arbor::image_io::write_outputs;
+    let dir = tempfile::tempdir().unwrap();
+    // A METU film: one unit of radiance is 1/255 of white, so white is radiance 255.
+    let film = Film { width: 2, height: 1, pixels: vec![Color::new(1.0, 0.5, 0.0), Color::splat(2.0)] };
+    let radiance = [Color::new(255.0, 127.5, 0.0), Color::splat(510.0)];
+    for ext in ["exr", "hdr"] {
+        let path = dir.path().join(format!("r.{ext}"));
+        write_outputs(&path, &film, 1.0 / 255.0, None).unwrap();
+        for (a, b) in read_image(&path).unwrap().pixels.iter().zip(&radiance) {
+            assert!((*a - *b).abs().max_element() <= 0.01 * b.max_element(), "{ext}: {a} vs {b}");
+        }
+    }
+    // 8-bit images are the film as it is.
+    let png = dir.path().join("r.png");
+    write_outputs(&png, &film, 1.0 / 255.0, None).unwrap();
+    assert_eq!(read_rgb8(&png).unwrap().2, film.to_rgb8());
 }
 
 #[test]
@@ -415,19 +435,19 @@ fn write_outputs_hdr_pair_is_written_whole_or_not_at_all() {
     // A folder holds the PNG's name: its rename fails after the EXR's has been made.
     fs::create_dir(&png).unwrap();
     let refused = format!("{}: Is a directory (os error 21)", png.display());
-    let err = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap_err();
+    let err = write_outputs(&exr, &film, 1.0, Some(&Tonemap::PREVIEW)).unwrap_err();
     assert_eq!(err.to_string(), refused);
     assert_eq!(strays(dir.path(), &[]), ["out.png"], "a new EXR without its PNG, or a temporary file");
     // An older EXR is given back its contents.
     fs::write(&exr, b"older image").unwrap();
-    let err = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap_err();
+    let err = write_outputs(&exr, &film, 1.0, Some(&Tonemap::PREVIEW)).unwrap_err();
     assert_eq!(err.to_string(), refused);
     assert_eq!(fs::read(&exr).unwrap(), b"older image");
     assert_eq!(strays(dir.path(), &[]), ["out.exr", "out.png"]);
     // Once the name is free, both files are replaced and nothing else is left.
     fs::remove_dir(&png).unwrap();
     fs::write(&png, b"older preview").unwrap();
-    let written = write_outputs(&exr, &film, Some(&Tonemap::PREVIEW)).unwrap();
+    let written = write_outputs(&exr, &film, 1.0, Some(&Tonemap::PREVIEW)).unwrap();
     assert_eq!(written, [exr.clone(), png.clone()]);
     assert_eq!(read_image(&exr).unwrap(), film);
     assert_eq!(read_rgb8(&png).unwrap().2, Tonemap::PREVIEW.apply(&film).to_rgb8());

@@ -2,9 +2,10 @@
 //! needs to rebuild the exact single-process image.
 //!
 //! - Display window: the full frame (`0,0 .. width,height`); data window: the slice's pixels.
-//! - Channels `R`, `G`, `B` (float): the slice's own mean (for looking at it); `W` (uint): the samples
-//!   per pixel this file holds (its weight); `sumR0..sumR3`, `sumG0..`, `sumB0..` (uint): each channel's
-//!   exact fixed-point sample sum ([`crate::accum`]), an `i128` as four little-endian 32-bit limbs.
+//! - Channels `R`, `G`, `B` (float): the slice's own mean, in the scene's radiance units like every HDR
+//!   image Arbor writes (for looking at it); `W` (uint): the samples per pixel this file holds (its
+//!   weight); `sumR0..sumR3`, `sumG0..`, `sumB0..` (uint): each channel's exact fixed-point sample sum
+//!   ([`crate::accum`]), an `i128` as four little-endian 32-bit limbs.
 //! - Header attributes: `arbor.render` (identity of the render: scene, camera and the options that
 //!   change pixels), `arbor.camera`, `arbor.spp` (samples per pixel of the full image),
 //!   `arbor.sampleStart` and `arbor.sampleEnd` (the samples held, `start..end`), `arbor.scale` (radiance
@@ -49,7 +50,7 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
     let count = s.samples.1 - s.samples.0;
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
     for (c, name) in CHANNELS.iter().enumerate() {
-        let mean = s.sums.iter().map(|p| p.value(s.scale, count).to_array()[c]).collect();
+        let mean = s.sums.iter().map(|p| p.value(1.0, count).to_array()[c]).collect();
         channels.push(AnyChannel::new(*name, FlatSamples::F32(mean)));
         for limb in 0..4 {
             let bits = s.sums.iter().map(|p| (p.0[c] as u128 >> (32 * limb)) as u32).collect();

@@ -15,6 +15,7 @@
 
 use std::path::Path;
 
+use super::levels::BlockLevels;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::math::Color;
@@ -210,6 +211,41 @@ pub fn compare_blocks_rgb8(
         share_off: if blocks == 0 { 0.0 } else { blocks_off as f64 / blocks as f64 },
         max_diff,
         bias: means(total, len / 3),
+    }
+}
+
+/// Compares block means already in display levels ([`super::levels`]; high-dynamic-range images under
+/// their reference's curve) of an image of `width` x `height` pixels: a block is off when a channel's mean
+/// differs by strictly more than `threshold` levels.
+///
+/// # Panics
+/// When the two have different blocks.
+pub fn compare_block_levels(
+    reference: &BlockLevels,
+    image: &BlockLevels,
+    width: u32,
+    height: u32,
+    threshold: u8,
+) -> BlockComparison {
+    assert_eq!(reference.pixels, image.pixels, "block means of images of different sizes or blocks");
+    let worst: Vec<f64> = reference
+        .means
+        .iter()
+        .zip(&image.means)
+        .map(|(r, i)| (0..3).map(|c| (i[c] - r[c]).abs()).fold(0.0, f64::max))
+        .collect();
+    let blocks = worst.len();
+    let blocks_off = worst.iter().filter(|&&d| d > f64::from(threshold)).count();
+    let (r, i) = (reference.mean(), image.mean());
+    BlockComparison {
+        width,
+        height,
+        block: reference.block,
+        blocks,
+        blocks_off,
+        share_off: if blocks == 0 { 0.0 } else { blocks_off as f64 / blocks as f64 },
+        max_diff: worst.iter().copied().fold(0.0, f64::max),
+        bias: [0, 1, 2].map(|c| i[c] - r[c]),
     }
 }
 

@@ -9,11 +9,14 @@
 //! - [`read_image`]: PNG, JPEG, PNM, OpenEXR, Radiance HDR into a film in display units (integer samples
 //!   divided by their maximum, float samples as they are); [`read_rgb8`] for exact 8-bit comparisons.
 //! - [`metrics`]: PSNR, RMSE, bias and the share of differing pixels (or KxK-pixel block means, for noisy
-//!   renders) against a reference image.
+//!   renders) against a reference image; [`levels`]: images as display levels for comparing them (an HDR
+//!   image through one curve its reference fixes); [`noisy`]: the rule for a noisy (path-traced)
+//!   reference, against a second seed's render.
 //!
 //! Codecs are the `image` crate's; this module only chooses formats, converts samples and handles files.
 
 mod jpeg;
+pub mod levels;
 pub mod metrics;
 pub mod noisy;
 mod read;

@@ -162,24 +162,39 @@ pub fn tone_mapped_beside(path: &Path) -> PathBuf {
     path.with_extension("png")
 }
 
-/// Writes a camera's image: `film` as it is to `path`, except that with a `tonemap` an 8-bit format gets
-/// the tone-mapped film, and a high-dynamic-range one gets the film as it is plus the tone-mapped PNG
-/// beside it ([`tone_mapped_beside`]), replacing a file of that name. Returns the files written: all of
-/// them, atomically, or none (see the module documentation).
-pub fn write_outputs(path: &Path, film: &Film, tonemap: Option<&Tonemap>) -> Result<Vec<PathBuf>> {
-    let Some(tm) = tonemap else {
-        write_image(path, film)?;
-        return Ok(vec![path.to_path_buf()]);
-    };
+/// Writes a camera's image. `film` holds display values, in which one unit of the scene's radiance is
+/// `unit` (the scene's radiance scale: 1/255 for METU files; 1 for a debug view). An 8-bit format gets
+/// the film as it is, or tone-mapped with a `tonemap`; a high-dynamic-range format gets radiance in the
+/// scene's own units (the film over `unit`, as the course's official EXRs hold it), plus with a
+/// `tonemap` the tone-mapped PNG of the film beside it ([`tone_mapped_beside`]), replacing a file of that
+/// name. Returns the files written: all of them, atomically, or none (see the module documentation).
+pub fn write_outputs(path: &Path, film: &Film, unit: f32, tonemap: Option<&Tonemap>) -> Result<Vec<PathBuf>> {
     if is_hdr_path(path) {
+        let radiance = in_radiance(film, unit);
+        let image = encoded(path, &radiance)?;
+        let Some(tm) = tonemap else {
+            write_atomic(path, &image)?;
+            return Ok(vec![path.to_path_buf()]);
+        };
         let png = tone_mapped_beside(path);
-        let (image, preview) = (encoded(path, film)?, encoded(&png, &tm.apply(film))?);
+        let preview = encoded(&png, &tm.apply(film))?;
         write_atomic_set(&[(path, &image), (&png, &preview)])?;
-        Ok(vec![path.to_path_buf(), png])
-    } else {
-        write_image(path, &tm.apply(film))?;
-        Ok(vec![path.to_path_buf()])
+        return Ok(vec![path.to_path_buf(), png]);
     }
+    match tonemap {
+        Some(tm) => write_image(path, &tm.apply(film))?,
+        None => write_image(path, film)?,
+    }
+    Ok(vec![path.to_path_buf()])
+}
+
+/// `film` over `unit`: display values back in the scene's radiance units.
+fn in_radiance(film: &Film, unit: f32) -> std::borrow::Cow<'_, Film> {
+    if unit == 1.0 {
+        return std::borrow::Cow::Borrowed(film);
+    }
+    let pixels = film.pixels.iter().map(|&c| c / unit).collect();
+    std::borrow::Cow::Owned(Film { width: film.width, height: film.height, pixels })
 }
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
