@@ -180,6 +180,8 @@ fn catalogue() -> Vec<Row> {
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
     render("no_objects.xml", 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\n"),
+    // --roulette picks the roulette of cameras that have one: a camera without says so.
+    cmd(&["render", "no_objects.xml", "--roulette", "course", "-o", "OUT"], 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\nwarning: --roulette course: camera 1 has no Russian roulette, its paths end at MaxRecursionDepth (a path-traced camera gets one from RussianRoulette or --path-options roulette)\n"),
     render("empty_object.json", 3, "error: empty_object.json:1:1: no top-level \"Scene\" object\n"),
     render("not_a_scene.xml", 3, "error: not_a_scene.xml:1:1: root element is <Mesh>, expected <Scene>\n"),
     // Zero-size images.

@@ -4,7 +4,7 @@
 //! and its window is neither empty nor inverted (left < right, bottom < top; `FovY` in (0, 180)).
 
 use super::Reader;
-use crate::renderer::{PathOptions, Renderer};
+use crate::renderer::{PathOptions, Renderer, Roulette};
 use crate::scene::desc::{CameraDesc, Lens, Window};
 use crate::scene::readers::tree::Node;
 use crate::tonemap::{Operator, Tonemap};
@@ -164,7 +164,11 @@ impl Reader<'_> {
                     let flag = match word {
                         "NextEventEstimation" => &mut o.next_event,
                         "ImportanceSampling" => &mut o.importance_sampling,
-                        "RussianRoulette" => &mut o.russian_roulette,
+                        // The element means what the course's renderer does with it.
+                        "RussianRoulette" => {
+                            o.roulette = Roulette::Course;
+                            continue;
+                        }
                         "MIS" => &mut o.mis,
                         other => {
                             let msg = format!(
@@ -177,7 +181,7 @@ impl Reader<'_> {
                     *flag = true;
                 }
                 let o = o.implied();
-                if self.desc.max_depth == 0 && !o.russian_roulette {
+                if self.desc.max_depth == 0 && o.roulette == Roulette::Off {
                     let msg = format!(
                         "Camera {id}: path tracing with MaxRecursionDepth 0 follows no bounce: emitters and, with \
                          NextEventEstimation, direct light only"
