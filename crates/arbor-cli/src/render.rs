@@ -204,6 +204,15 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
     let scene = Scene::build(desc, &spec, env)?;
+    let warn = args.quiet < 2 && !args.no_warnings;
+    let whitted = args.debug.is_none_or(|v| v.shades())
+        && cameras.iter().any(|&c| {
+            let own = scene.cameras[c].renderer;
+            args.integrator.renderer(own).is_ok_and(|r| r.unwrap_or(own) == Renderer::Whitted)
+        });
+    if let Some(w) = crate::warnings::tree_warning(&crate::shown(&args.scene), &scene).filter(|_| warn && whitted) {
+        eprintln!("warning: {w}");
+    }
     signals.enter(Stage::Render);
     let cull = if args.cull {
         Some(true)
@@ -275,6 +284,12 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         };
         if args.quiet == 0 {
             summary(&args, &scene, &path, window, &stats, parse_time);
+        }
+        if let Some(w) =
+            crate::warnings::capped_warning(&crate::shown(&args.scene), &cam.id, &stats, window_pixels(window))
+                .filter(|_| warn)
+        {
+            eprintln!("warning: {w}");
         }
         say!("Saved: {}", path.display());
         for p in &extra {
@@ -384,4 +399,9 @@ fn summary(
         s.mean_depth,
         args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
     );
+}
+
+/// Pixels in a window `(x0, y0, x1, y1)`.
+fn window_pixels((x0, y0, x1, y1): (u32, u32, u32, u32)) -> u64 {
+    (x1 - x0) as u64 * (y1 - y0) as u64
 }

@@ -1,9 +1,13 @@
 //! Warnings about a scene that renders but probably not as meant: the readers' own (unknown elements,
 //! unused properties) and two checks of the description: a scene with no objects (every image is the
 //! background) and a camera whose up vector is parallel to its gaze (the image's rotation about the
-//! gaze is then undefined).
+//! gaze is then undefined); and two about Whitted ray trees too large for their budget
+//! ([`arbor::integrator::TreePlan`]): before the render, when a sample may need more rays than it allows,
+//! and after it, when samples did.
 
-use arbor::scene::SceneDesc;
+use arbor::integrator::{TreePlan, TREE_BUDGET};
+use arbor::render::RenderStats;
+use arbor::scene::{Scene, SceneDesc};
 
 /// Every warning about `desc`, in file order of the readers' and then the checks'.
 pub fn scene_warnings(desc: &SceneDesc) -> Vec<String> {
@@ -22,4 +26,23 @@ pub fn scene_warnings(desc: &SceneDesc) -> Vec<String> {
         }
     }
     out
+}
+
+/// The warning before rendering `scene` (named `name`) with the Whitted integrator, if a camera
+/// sample's ray tree may need more rays than [`TREE_BUDGET`].
+pub fn tree_warning(name: &str, scene: &Scene) -> Option<String> {
+    TreePlan::of(scene).warning().map(|w| format!("{name}: {w}"))
+}
+
+/// The warning after an image of `camera` (`pixels` rendered) whose samples reached their ray-tree
+/// budget, if any did.
+pub fn capped_warning(name: &str, camera: &str, stats: &RenderStats, pixels: u64) -> Option<String> {
+    let total = pixels * stats.samples.1.saturating_sub(stats.samples.0) as u64;
+    (stats.capped_samples > 0).then(|| {
+        format!(
+            "{name}: Camera {camera}: {} of {total} samples needed more than {TREE_BUDGET} rays and dropped \
+             their lightest branches",
+            stats.capped_samples
+        )
+    })
 }

@@ -87,6 +87,9 @@ pub struct RenderStats {
     pub heatmap_max: Option<u32>,
     /// The render was cancelled before it finished: the film is incomplete.
     pub cancelled: bool,
+    /// Camera samples whose Whitted ray tree reached its budget and dropped the rest
+    /// ([`crate::integrator::TREE_BUDGET`]).
+    pub capped_samples: u64,
 }
 
 impl RenderStats {
@@ -303,6 +306,7 @@ fn trace(
         samples: (k0, k1),
         heatmap_max: None,
         cancelled,
+        capped_samples: log.capped_samples,
     };
     Ok((traced, stats, scale))
 }

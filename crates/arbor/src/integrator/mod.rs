@@ -3,11 +3,13 @@
 pub mod debug;
 pub mod offset;
 mod path;
+mod prune;
 mod ray_log;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};
 pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
+pub use prune::{Pruning, TreePlan, PRUNED_LEVELS, TREE_BUDGET};
 pub use ray_log::{RayLog, TIMED_EVERY};
 pub use whitted::Whitted;
 

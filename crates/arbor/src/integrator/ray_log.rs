@@ -20,6 +20,12 @@ pub const TIMED_EVERY: u32 = 64;
 pub struct RayLog {
     /// Rays traced: camera, shadow and secondary.
     pub rays: u64,
+    /// Rays of the current camera sample's Whitted tree (camera and secondary, not shadow rays).
+    pub tree: u32,
+    /// Whether the current sample's tree reached its budget and dropped branches.
+    pub capped: bool,
+    /// Camera samples whose trees reached their budget.
+    pub capped_samples: u64,
     queries: u64,
     timed_queries: u64,
     timed: Duration,
@@ -72,6 +78,7 @@ impl RayLog {
     /// Adds `other`'s rays and times to these.
     pub fn merge(&mut self, other: &RayLog) {
         self.rays += other.rays;
+        self.capped_samples += other.capped_samples;
         self.queries += other.queries;
         self.timed_queries += other.timed_queries;
         self.timed += other.timed;
