@@ -125,6 +125,8 @@ fn catalogue() -> Vec<Row> {
     render("brdf_negative_exponent.xml", 3, "error: brdf_negative_exponent.xml:19:54: BRDF 1: negative exponent -5\n"),
     render("brdf_normalized_not_boolean.xml", 3, "error: brdf_normalized_not_boolean.xml:19:36: attribute normalized: expected true or false, found 'yes'\n"),
     render("brdf_torrance_sparrow_no_index.xml", 3, "error: brdf_torrance_sparrow_no_index.xml:22:26: Material 1: BRDF '1' (TorranceSparrow) needs a <RefractionIndex> for its Fresnel term\n"),
+    render("brdf_torrance_sparrow_negative_index.xml", 3, "error: brdf_torrance_sparrow_negative_index.xml:18:56: BRDF 1: RefractiveIndex -1.5 must be positive\n"),
+    render("brdf_torrance_sparrow_material_index_negative.xml", 3, "error: brdf_torrance_sparrow_material_index_negative.xml:24:13: Material 1: RefractionIndex -1.5 must be positive\n"),
     // Emissive objects: a negative radiance, a light mesh without triangles, a light without radiance.
     render("light_negative_radiance.xml", 3, "error: light_negative_radiance.xml:29:87: LightSphere 1: negative Radiance [1, -2, 1]\n"),
     render("light_mesh_no_triangles.xml", 3, "error: light_mesh_no_triangles.xml:29:9: LightMesh 1: a light mesh needs at least one triangle\n"),
