@@ -237,6 +237,8 @@ fn catalogue() -> Vec<Row> {
     // Textures: missing or undecodable images, unknown modes, types and ids, coordinates out of range,
     // divisors and frequencies that are not positive.
     render("texture_coord_out_of_range.xml", 3, "error: texture_coord_out_of_range.xml:38:66: Mesh 1: texture coordinate 3 + textureOffset 1 = 4 out of range (TexCoordData has 3 pairs, numbered from 1)\n"),
+    render("texture_coords_empty.xml", 3, "error: texture_coords_empty.xml:34:44: Mesh 1: image texture '1' needs texture coordinates, but TexCoordData has no (u, v) pairs (every point would show the texel at (0, 0))\n"),
+    render("texture_checkerboard_scale_zero.xml", 3, "error: texture_checkerboard_scale_zero.xml:28:13: TextureMap 1: Scale 0 must be positive\n"),
     render("texture_image_missing.xml", 3, "error: texture_image_missing.xml:24:17: cannot read texture image 'nothere.png': No such file or directory (os error 2)\n"),
     render("texture_image_unreadable.xml", 3, "error: texture_image_unreadable.xml:24:17: cannot read texture image 'not_an_image.png': cannot decode image: Format error decoding Png: Invalid PNG signature.\n"),
     render("texture_image_truncated_jpg.xml", 3, "error: texture_image_truncated_jpg.xml:24:17: cannot read texture image 'truncated.jpg': cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)\n"),
