@@ -96,6 +96,8 @@ fn catalogue() -> Vec<Row> {
     render("near_plane_inverted.xml", 3, "error: near_plane_inverted.xml:7:13: Camera 1: NearPlane left 1 must be less than right -1\n"),
     render("near_plane_empty.xml", 3, "error: near_plane_empty.xml:7:13: Camera 1: NearPlane bottom 0.5 must be less than top 0.5\n"),
     render("fovy_180.xml", 3, "error: fovy_180.xml:7:13: Camera 1: FovY 180 must be in (0, 180) degrees\n"),
+    render("near_plane_overflow.xml", 3, "error: near_plane_overflow.xml:7:13: Camera 1: the NearPlane window's width overflows to infinity (beyond the range of 32-bit floats)\n"),
+    render("fovy_window_overflow.xml", 3, "error: fovy_window_overflow.xml:7:13: Camera 1: the window of NearDistance 1e38 and FovY 170 has a width that overflows to infinity (beyond the range of 32-bit floats)\n"),
     render("area_light_zero_size.xml", 3, "error: area_light_zero_size.xml:18:13: AreaLight 1: Size 0 must be positive\n"),
     // Tone mapping and spot lights (hw5) out of range.
     render("material_degamma_unknown.xml", 3, "error: material_degamma_unknown.xml:19:26: Material 1: degamma must be true or false, not 'yes'\n"),
