@@ -135,6 +135,8 @@ fn catalogue() -> Vec<Row> {
     render("light_missing_radiance.xml", 3, "error: light_missing_radiance.xml:29:9: <LightMesh>: missing <Radiance>\n"),
     render("motion_blur_nan.xml", 3, "error: motion_blur_nan.xml:29:82: <MotionBlur>: non-finite number 'nan'\n"),
     render("motion_blur_short.xml", 3, "error: motion_blur_short.xml:29:82: <MotionBlur>: expected 3 numbers, found 2\n"),
+    render("motion_blur_overflow.xml", 3, "error: motion_blur_overflow.xml:29:9: Sphere 1: its bounds swept by its MotionBlur overflow to infinity (beyond the range of 32-bit floats)\n"),
+    render("sphere_bounds_overflow.xml", 3, "error: sphere_bounds_overflow.xml:29:9: Sphere 1: its bounds overflow to infinity (beyond the range of 32-bit floats)\n"),
     // Indices out of range.
     render("face_index_out_of_range.xml", 3, "error: face_index_out_of_range.xml:29:44: Mesh 1: vertex index 9 out of range (VertexData has 3 vertices, numbered from 1)\n"),
     render("face_index_zero.xml", 3, "error: face_index_zero.xml:29:44: Mesh 1: vertex index 0 out of range (VertexData has 3 vertices, numbered from 1)\n"),
