@@ -170,6 +170,12 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         for w in crate::warnings::scene_warnings(&desc) {
             eprintln!("warning: {w}");
         }
+        for cam in cameras.iter().map(|&c| &desc.cameras[c]) {
+            let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?.unwrap_or(cam.renderer);
+            if let Some(w) = crate::warnings::dark_path_tracing(&desc, cam, renderer, args.env.is_some()) {
+                eprintln!("warning: {w}");
+            }
+        }
     }
     if slice.is_some() && cameras.len() != 1 {
         return Err(Failure::Usage(format!(

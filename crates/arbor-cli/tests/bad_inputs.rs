@@ -186,6 +186,11 @@ fn catalogue() -> Vec<Row> {
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
     render("no_objects.xml", 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\n"),
+    // A path tracer with no light it can take: every object black (the background still shows).
+    render("path_tracing_no_light.xml", 0, "warning: path_tracing_no_light.xml:4:9: Camera 1: the path tracer finds no light: the scene has no light, no emitter and no environment map; every object renders black\n"),
+    render("path_tracing_point_light_no_nee.xml", 0, "warning: path_tracing_point_light_no_nee.xml:4:9: Camera 1: the path tracer finds no light: without NextEventEstimation it takes no light from point, spot, directional or area lights, and the scene has no emitter or environment map (NextEventEstimation in RendererParams, or --path-options next-event, samples them); every object renders black\n"),
+    render("no_light.xml", 0, ""),
+    cmd(&["render", "no_light.xml", "--integrator", "path", "-o", "OUT"], 0, "warning: no_light.xml:3:9: Camera 1: the path tracer finds no light: the scene has no light, no emitter and no environment map; every object renders black\n"),
     render("empty_object.json", 3, "error: empty_object.json:1:1: no top-level \"Scene\" object\n"),
     render("not_a_scene.xml", 3, "error: not_a_scene.xml:1:1: root element is <Mesh>, expected <Scene>\n"),
     // Zero-size images.
