@@ -203,6 +203,10 @@ fn catalogue() -> Vec<Row> {
     render("huge_work.xml", 3, "error: huge_work.xml:3:9: Camera 1: 268435456 pixels x 1024 samples = 274877906944 samples, more than the limit of 17179869184; --no-limits lifts the limits\n"),
     render("huge_work_cameras.xml", 3, "error: huge_work_cameras.xml: the scene's 2 cameras ask for 19327352832 samples in all, more than the limit of 17179869184; --no-limits lifts the limits\n"),
     render("deep_recursion.xml", 3, "error: deep_recursion.xml:2:5: MaxRecursionDepth 100 exceeds the limit of 64; --no-limits lifts the limits\n"),
+    // A run of several cameras checks every output name, and reserves every image's memory, before the
+    // first render: the first image was written, then the second failed.
+    render("image_name_too_long.xml", 3, "error: image_name_too_long.xml:19:13: Camera 2: ImageName 'bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb…bbbbbbbbbbbb.png': a file or folder name in it is 304 bytes long, more than the 255 this file system takes (NAME_MAX)\n"),
+    render("memory_second_camera.xml", 4, "error: not enough memory for a 16000x16000 image (23.8 GiB)\n"),
     // Not a scene file.
     render("not_utf8.xml", 3, "error: not_utf8.xml: byte 309: not UTF-8 text\n"),
     render("entity_declared.xml", 3, "error: entity_declared.xml:4:5: entity declarations (<!ENTITY>) are not supported: no scene format uses them\n"),

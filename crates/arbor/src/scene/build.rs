@@ -406,6 +406,7 @@ mod tests {
             width: 800,
             height: 800,
             image_name: "x.png".into(),
+            name_loc: Location::file("x.xml"),
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,

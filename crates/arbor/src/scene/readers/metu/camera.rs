@@ -143,6 +143,7 @@ impl Reader<'_> {
             width,
             height,
             image_name,
+            name_loc: name_node.loc(p),
             num_samples,
             transform,
             lens,
