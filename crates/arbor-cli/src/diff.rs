@@ -70,11 +70,39 @@ enum Images {
     Hdr { reference: Film, images: Vec<Film> },
 }
 
-/// Reads the reference and `images`, all 8-bit or all HDR, all of one size.
+/// One image as read: 8-bit levels, or radiance for an HDR file.
+enum Read {
+    Rgb8(u32, u32, Vec<u8>),
+    Hdr(Film),
+}
+
+impl Read {
+    fn of(path: &Path) -> Result<Read, Failure> {
+        Ok(if is_hdr_path(path) {
+            Read::Hdr(read_image(path)?)
+        } else {
+            let (w, h, px) = read_rgb8(path)?;
+            Read::Rgb8(w, h, px)
+        })
+    }
+
+    fn size(&self) -> (u32, u32) {
+        match self {
+            Read::Rgb8(w, h, _) => (*w, *h),
+            Read::Hdr(f) => (f.width, f.height),
+        }
+    }
+}
+
+/// Reads the reference and `images` (each fails as a file first), then checks that they are all 8-bit or
+/// all HDR, and all of one size.
 fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
-    let hdr = is_hdr_path(reference);
-    for path in images {
-        if is_hdr_path(path) != hdr {
+    let first = Read::of(reference)?;
+    let rest = images.iter().map(|p| Read::of(p)).collect::<Result<Vec<_>, _>>()?;
+    let want = first.size();
+    for (path, read) in images.iter().zip(&rest) {
+        let (hdr, other) = (matches!(first, Read::Hdr(_)), matches!(read, Read::Hdr(_)));
+        if hdr != other {
             let (what, other) = if hdr { ("an HDR", "an 8-bit") } else { ("an 8-bit", "an HDR") };
             return Err(Failure::Usage(format!(
                 "{} is {other} image but the reference {} is {what} one: compare radiance with radiance \
@@ -83,32 +111,27 @@ fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
                 reference.display()
             )));
         }
-    }
-    let size_check = |path: &Path, got: (u32, u32), want: (u32, u32)| {
-        if got == want {
-            return Ok(());
+        let got = read.size();
+        if got != want {
+            let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
+            return Err(arbor::Error::Invalid(msg).into());
         }
-        let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
-        Err(Failure::from(arbor::Error::Invalid(msg)))
-    };
-    if hdr {
-        let reference = read_image(reference)?;
-        let mut films = Vec::new();
-        for path in images {
-            let film = read_image(path)?;
-            size_check(path, (film.width, film.height), (reference.width, reference.height))?;
-            films.push(film);
-        }
-        return Ok(Images::Hdr { reference, images: films });
     }
-    let (width, height, reference) = read_rgb8(reference)?;
-    let mut rgbs = Vec::new();
-    for path in images {
-        let (w, h, px) = read_rgb8(path)?;
-        size_check(path, (w, h), (width, height))?;
-        rgbs.push(px);
-    }
-    Ok(Images::Rgb8 { width, height, reference, images: rgbs })
+    Ok(match first {
+        Read::Hdr(reference) => Images::Hdr {
+            reference,
+            images: rest.into_iter().filter_map(|r| if let Read::Hdr(f) = r { Some(f) } else { None }).collect(),
+        },
+        Read::Rgb8(width, height, reference) => Images::Rgb8 {
+            width,
+            height,
+            reference,
+            images: rest
+                .into_iter()
+                .filter_map(|r| if let Read::Rgb8(_, _, px) = r { Some(px) } else { None })
+                .collect(),
+        },
+    })
 }
 
 impl Images {

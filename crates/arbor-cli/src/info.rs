@@ -115,7 +115,8 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         };
         say!("object     {}: {what}", o.name);
     }
-    for w in crate::warnings::scene_warnings(&desc) {
+    let dark = desc.cameras.iter().filter_map(|c| crate::warnings::dark_path_tracing(&desc, c, c.renderer, false));
+    for w in crate::warnings::scene_warnings(&desc).into_iter().chain(dark) {
         say!("warning    {w}");
     }
     let scene = Scene::build(desc, &spec, None)?;

@@ -63,6 +63,9 @@ pub enum Failure {
     Usage(String),
     /// An error from the library (exit 3 for bad input, 4 for I/O).
     Arbor(arbor::Error),
+    /// An error about a file, after where the scene names it (`s.xml:9:13: Camera 1: ImageName 'x.png'`):
+    /// exit 3 or 4, as the error's.
+    At(String, arbor::Error),
     /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
     Interrupted(u8),
     /// A buffer could not be allocated (exit 4, like other failures of the machine rather than the input).
@@ -135,6 +138,10 @@ fn report(failure: Failure) -> ExitCode {
         }
         Failure::Arbor(e) => {
             eprintln!("error: {e}");
+            ExitCode::from(if e.is_io() { 4 } else { 3 })
+        }
+        Failure::At(at, e) => {
+            eprintln!("error: {at}: {e}");
             ExitCode::from(if e.is_io() { 4 } else { 3 })
         }
     }

@@ -1,19 +1,21 @@
 //! `arbor render`: every camera of a scene to the image file it names, with a progress bar on a terminal
-//! (plain lines otherwise), one summary line and one `Saved: PATH` line per image, and optionally the
-//! same numbers as JSON (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs
-//! instead ([`crate::slice`]).
+//! (plain lines otherwise), one summary line per image, and optionally the same numbers as JSON
+//! (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs instead ([`crate::slice`]).
 //!
 //! Every output path is worked out and checked before the scene is built ([`crate::outputs`]), and the
-//! memory an image needs is reserved before it is rendered (exit 4 when there is not enough). SIGINT and
-//! SIGTERM stop the command at any stage ([`crate::signals`]): the image being rendered is not written
-//! (the previous file, if any, stays as it was; images are written whole, by rename), and the command
-//! exits 130 or 143.
+//! memory an image needs is reserved before it is rendered (exit 4 when there is not enough). The files
+//! of a run (each camera's image, the PNG beside an HDR one, the statistics) are encoded as their render
+//! ends and written together after the last one, all or none ([`arbor::image_io::write_files`]), then
+//! listed as `Saved: PATH` lines: a run that fails at its third camera leaves no image of its first two
+//! and every older file as it was. The price is memory: the encoded files wait (reserved up front,
+//! [`crate::memory::reserve_run`]). SIGINT and SIGTERM stop the command at any stage
+//! ([`crate::signals`]): nothing of the run is written, and the command exits 130 or 143.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use arbor::accel::{AccelConfig, AccelKind};
-use arbor::farm::{write_partial, Partial};
+use arbor::farm::{encode_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, render_sums, RenderOptions, RenderStats};
@@ -40,8 +42,10 @@ pub struct RenderArgs {
     /// Folder for the images (created if missing); each camera's file name comes from the scene. A name
     /// ending in an image extension (.png, .ppm, .exr, .hdr, .jpg, .jpeg) is the image of a one-camera
     /// scene. An .exr or .hdr image holds radiance in the scene's units (255 is an 8-bit image's white in
-    /// METU files) and gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a file of that name; the two are written together or not at all. For a slice (--tile,
-    /// --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
+    /// METU files) and gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a file of that
+    /// name. Every file of the run is written after the last render, all together, or none when the run
+    /// fails. For a slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial
+    /// EXR.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
     /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.
@@ -170,6 +174,12 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         for w in crate::warnings::scene_warnings(&desc) {
             eprintln!("warning: {w}");
         }
+        for cam in cameras.iter().map(|&c| &desc.cameras[c]) {
+            let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?.unwrap_or(cam.renderer);
+            if let Some(w) = crate::warnings::dark_path_tracing(&desc, cam, renderer, args.env.is_some()) {
+                eprintln!("warning: {w}");
+            }
+        }
     }
     if slice.is_some() && cameras.len() != 1 {
         return Err(Failure::Usage(format!(
@@ -202,6 +212,10 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     if let Some(file) = &args.stats_json {
         crate::outputs::check_writable(file, false)?;
     }
+    if slice.is_none() {
+        let cams: Vec<_> = cameras.iter().map(|&c| &desc.cameras[c]).collect();
+        crate::memory::reserve_run(&cams, &targets, args.crop, args.debug.is_none())?;
+    }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
     let scene = Scene::build(desc, &spec, env)?;
     let warn = args.quiet < 2 && !args.no_warnings;
@@ -233,13 +247,14 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         sampler: args.integrator.sampler.into(),
     };
     let mut records = Vec::new();
+    // Every file of the run, encoded, written together after the last render: all of them or none, so
+    // that a run that fails (an error, a signal, too little memory) leaves every older file as it was.
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?;
         let base = RenderOptions { renderer, ..base.clone() };
-        // The tone-mapped PNG beside a high-dynamic-range image.
-        let mut extra = Vec::new();
         // A debug view is written as it is.
         let tonemap = if args.debug.is_some() { None } else { cam.tonemap };
         let (path, stats, window) = match &slice {
@@ -257,9 +272,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 signals.check()?;
-                signals.writing(|| {
-                    write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), tonemap, sums })
-                })?;
+                let part = Partial { identity: id, camera: cam.id.clone(), tonemap, sums };
+                files.push((target.clone(), encode_partial(&target, &part)?));
                 (target, stats, window)
             }
             None => {
@@ -276,9 +290,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 } else {
                     (tonemap.or_else(|| hdr_preview(&target, scene.radiance_scale)), scene.radiance_scale)
                 };
-                let written =
-                    signals.writing(|| arbor::image_io::write_outputs(&target, &film, unit, tonemap.as_ref()))?;
-                extra = written.into_iter().filter(|p| *p != target).collect();
+                files.extend(arbor::image_io::encode_outputs(&target, &film, unit, tonemap.as_ref())?);
                 (target, stats, window)
             }
         };
@@ -290,10 +302,6 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 .filter(|_| warn)
         {
             eprintln!("warning: {w}");
-        }
-        say!("Saved: {}", path.display());
-        for p in &extra {
-            say!("Saved: {}", p.display());
         }
         if let Some(max) = stats.heatmap_max {
             // Printed even with --quiet: without it the heatmap's colours have no scale.
@@ -319,12 +327,17 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             "triangles": scene.geometry.counts.triangles,
         }));
     }
+    let images = files.len();
     if let Some(file) = &args.stats_json {
         let text = serde_json::to_string_pretty(&json!({ "images": records }))
             .map_err(|e| arbor::Error::Invalid(format!("cannot encode the statistics: {e}")))?;
-        signals.writing(|| std::fs::write(file, text + "\n")).map_err(|e| arbor::Error::io(file, e))?;
+        files.push((file.clone(), (text + "\n").into_bytes()));
     }
-    // A signal during the last write let that (atomic) write finish; the run still reports it.
+    signals.writing(|| arbor::image_io::write_files(&files))?;
+    for (path, _) in &files[..images] {
+        say!("Saved: {}", path.display());
+    }
+    // A signal during the write let that (atomic) write finish; the run still reports it.
     signals.check()
 }
 

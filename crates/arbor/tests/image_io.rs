@@ -453,3 +453,41 @@ fn write_outputs_hdr_pair_is_written_whole_or_not_at_all() {
     assert_eq!(read_rgb8(&png).unwrap().2, Tonemap::PREVIEW.apply(&film).to_rgb8());
     assert_eq!(strays(dir.path(), &[]), ["out.exr", "out.png"]);
 }
+
+#[test]
+fn write_files_of_several_cameras_are_written_all_or_none() {
+    use arbor::image_io::{encode_outputs, write_files};
+    let dir = tempfile::tempdir().unwrap();
+    let film = level_film(2, 2);
+    let names = ["a.png", "b.ppm", "c.exr"];
+    let mut files = Vec::new();
+    for n in names {
+        files.extend(encode_outputs(&dir.path().join(n), &film, 1.0, None).unwrap());
+    }
+    fs::write(dir.path().join("a.png"), b"older a").unwrap();
+    fs::write(dir.path().join("b.ppm"), b"older b").unwrap();
+    // The last target is a folder: its rename fails after the first two were made, and they are undone.
+    fs::create_dir(dir.path().join("c.exr")).unwrap();
+    let err = write_files(&files).unwrap_err();
+    assert_eq!(err.to_string(), format!("{}: Is a directory (os error 21)", dir.path().join("c.exr").display()));
+    assert_eq!(fs::read(dir.path().join("a.png")).unwrap(), b"older a");
+    assert_eq!(fs::read(dir.path().join("b.ppm")).unwrap(), b"older b");
+    assert_eq!(strays(dir.path(), &[]), ["a.png", "b.ppm", "c.exr"]);
+    fs::remove_dir(dir.path().join("c.exr")).unwrap();
+    write_files(&files).unwrap();
+    for n in names {
+        assert_eq!(read_image(&dir.path().join(n)).unwrap().to_rgb8(), film.to_rgb8(), "{n}");
+    }
+    assert_eq!(strays(dir.path(), &[]), names);
+}
+
+#[test]
+fn write_temporary_names_fit_the_file_system_whenever_the_target_does() {
+    // A 255-byte name (the usual NAME_MAX): its temporary file, `.<name>.<pid>.<n>.tmp`, would not fit.
+    let dir = tempfile::tempdir().unwrap();
+    // The cut the temporary name makes (at 200 bytes) falls inside the two bytes of 'é'.
+    let target = dir.path().join(format!("{}é{}.png", "a".repeat(199), "a".repeat(50)));
+    assert_eq!(target.file_name().unwrap().len(), 255);
+    arbor::image_io::write_image(&target, &level_film(2, 2)).unwrap();
+    assert_eq!(strays(dir.path(), &[]), [target.file_name().unwrap().to_str().unwrap()]);
+}

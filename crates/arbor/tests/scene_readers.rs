@@ -44,6 +44,7 @@ fn neutral(mut d: SceneDesc) -> SceneDesc {
     d.warnings.clear();
     for c in &mut d.cameras {
         c.loc = nowhere.clone();
+        c.name_loc = nowhere.clone();
     }
     for o in &mut d.objects {
         o.loc = nowhere.clone();

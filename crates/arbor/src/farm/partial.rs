@@ -45,6 +45,11 @@ const TONEMAP_FIELDS: [&str; 5] =
 
 /// Writes `part` to `path` (atomically: a temporary file renamed over the target).
 pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
+    crate::image_io::write::write_atomic(path, &encode_partial(path, part)?)
+}
+
+/// The bytes [`write_partial`] writes to `path` (named in a failure to encode).
+pub fn encode_partial(path: &Path, part: &Partial) -> Result<Vec<u8>> {
     let s = &part.sums;
     let (x0, y0, x1, y1) = s.window;
     let count = s.samples.1 - s.samples.0;
@@ -82,7 +87,7 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
         .write()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
-    crate::image_io::write::write_atomic(path, &bytes.into_inner())
+    Ok(bytes.into_inner())
 }
 
 /// Reads a partial image written by [`write_partial`].

@@ -26,4 +26,7 @@ pub use metrics::{
     compare_blocks_files, compare_blocks_rgb8, compare_files, compare_rgb8, diff_image, BlockComparison, Comparison,
 };
 pub use read::{read_image, read_rgb8};
-pub use write::{is_hdr_path, tone_mapped_beside, write_image, write_outputs, SUPPORTED_WRITE_EXTENSIONS};
+pub use write::{
+    encode_outputs, is_hdr_path, tone_mapped_beside, write_files, write_image, write_outputs,
+    SUPPORTED_WRITE_EXTENSIONS,
+};

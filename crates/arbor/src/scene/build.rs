@@ -257,7 +257,13 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             Shape::Sphere(s) => s.bounds(),
         };
         // A translation sweeps the box between its two ends; their union holds every box in between.
-        let bounds = bounds.union(Aabb::new(bounds.min + object.motion, bounds.max + object.motion));
+        let swept = bounds.union(Aabb::new(bounds.min + object.motion, bounds.max + object.motion));
+        if !finite_or_empty(&swept) {
+            let how = if finite_or_empty(&bounds) { "its bounds swept by its MotionBlur" } else { "its bounds" };
+            let msg = format!("{}: {how} overflow to infinity (beyond the range of 32-bit floats)", object.name);
+            return Err(Error::input(object.loc.clone(), msg));
+        }
+        let bounds = swept;
         match &shape {
             Shape::Mesh(m) => counts.triangles += m.mesh.len(),
             Shape::Sphere(_) => counts.spheres += 1,
@@ -297,6 +303,12 @@ fn top_level(spec: &AccelConfig) -> AccelConfig {
         _ => {}
     }
     top
+}
+
+/// True for a box of finite corners, or the empty box of an object without primitives: an infinite
+/// corner would make the top level's costs and every ray's slab distances infinite or NaN.
+fn finite_or_empty(b: &Aabb) -> bool {
+    b.is_empty() || (b.min.is_finite() && b.max.is_finite())
 }
 
 /// An object's motion over the shutter interval, `None` when it stands still.
@@ -394,6 +406,7 @@ mod tests {
             width: 800,
             height: 800,
             image_name: "x.png".into(),
+            name_loc: Location::file("x.xml"),
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,

@@ -161,6 +161,8 @@ pub struct CameraDesc {
     pub height: u32,
     /// Output file name, relative to the output folder; its extension picks the format.
     pub image_name: String,
+    /// Where the file gives `image_name` (the camera's own location when the format derives the name).
+    pub name_loc: Location,
     /// Samples per pixel (`NumSamples`), at least 1; the METU readers give a perfect square.
     pub num_samples: u32,
     /// Camera transform (applied to position, gaze and up).

@@ -111,6 +111,7 @@ fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc
         width: WIDTH,
         height: HEIGHT,
         image_name: format!("{stem}.png"),
+        name_loc: c.loc(at),
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,
