@@ -245,6 +245,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         seed: args.seed,
         renderer: None,
         sampler: args.integrator.sampler.into(),
+        heatmap_scale: None,
     };
     let mut records = Vec::new();
     // Every file of the run, encoded, written together after the last render: all of them or none, so

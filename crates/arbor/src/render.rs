@@ -28,10 +28,12 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use crate::accum::SampleSum;
+use crate::camera::Camera;
 use crate::error::Result;
 use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
-use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
+use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayEvent, RayLog};
+use crate::math::{Color, Ray};
 use crate::renderer::Renderer;
 use crate::sampler::{SampleStream, SamplerKind, Strata};
 use crate::scene::Scene;
@@ -65,6 +67,9 @@ pub struct RenderOptions {
     pub seed: u64,
     /// How the path tracer's random numbers are spread over a pixel's samples.
     pub sampler: SamplerKind,
+    /// The heatmap view's colours run up to this cost instead of the image's own maximum (to show two
+    /// structures' heatmaps on one scale).
+    pub heatmap_scale: Option<u32>,
 }
 
 /// What a render measured.
@@ -115,11 +120,21 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Film, RenderStats)> {
-    let cam = &scene.cameras[camera];
+    render_camera(scene, &scene.cameras[camera], opts, progress)
+}
+
+/// [`render`] through any camera of the scene's, such as one a live view moved
+/// ([`Camera::posed`]).
+pub fn render_camera(
+    scene: &Scene,
+    cam: &Camera,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Film, RenderStats)> {
     let (w, h) = (cam.width, cam.height);
     // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
     let mut film = Film::try_new(w, h)?;
-    let (traced, stats, scale) = trace(scene, camera, opts, progress)?;
+    let (traced, stats, scale) = trace(scene, cam, opts, progress)?;
     let count = stats.samples.1 - stats.samples.0;
     for ((x0, y0, tw), sums, _, _) in traced {
         for (k, s) in sums.into_iter().enumerate() {
@@ -128,7 +143,7 @@ pub fn render(
         }
     }
     let heatmap_max = match opts.debug {
-        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
+        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film, opts.heatmap_scale)),
         Some(DebugView::Boxes { depth }) => {
             overlay_boxes(&mut film, cam, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
             None
@@ -173,7 +188,7 @@ pub fn render_sums(
     let ww = (window.2 - window.0) as usize;
     let mut sums = sums_buffer(window)?;
     sums.resize(ww * (window.3 - window.1) as usize, SampleSum::default());
-    let (traced, stats, scale) = trace(scene, camera, &opts, progress)?;
+    let (traced, stats, scale) = trace(scene, cam, &opts, progress)?;
     for ((x0, y0, tw), tile, _, _) in traced {
         for (k, s) in tile.into_iter().enumerate() {
             let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
@@ -204,12 +219,11 @@ type Traced = Vec<((u32, u32, u32), Vec<SampleSum>, RayLog, Duration)>;
 
 fn trace(
     scene: &Scene,
-    camera: usize,
+    cam: &Camera,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Traced, RenderStats, f32)> {
     let start = Instant::now();
-    let cam = &scene.cameras[camera];
     let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
     let integrator = Integrator::new(scene, cam, opts.renderer.unwrap_or(cam.renderer), cull);
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
@@ -252,13 +266,7 @@ fn trace(
                 streams.clear();
                 for &(x, y) in group {
                     for k in k0..k1 {
-                        let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
-                        let offset = strata.offset(k, &mut sample.rng);
-                        let mut ray = cam.ray(x, y, offset, sample.rng.next_2d());
-                        // A time is drawn only when something moves, so still scenes keep their streams.
-                        if moving {
-                            ray = ray.with_time(sample.rng.next_f32());
-                        }
+                        let (ray, sample) = camera_sample(cam, opts, strata, moving, (x, y, k));
                         batch.push(match &debug {
                             Some(_) => ray,
                             None => integrator.camera_ray(&ray),
@@ -309,6 +317,44 @@ fn trace(
         capped_samples: log.capped_samples,
     };
     Ok((traced, stats, scale))
+}
+
+/// Sample `k` of pixel `(x, y)`: its camera ray (before culling) and the random stream its shading
+/// continues.
+fn camera_sample(
+    cam: &Camera,
+    opts: &RenderOptions,
+    strata: Strata,
+    moving: bool,
+    (x, y, k): (u32, u32, u32),
+) -> (Ray, SampleStream) {
+    let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
+    let offset = strata.offset(k, &mut sample.rng);
+    let ray = cam.ray(x, y, offset, sample.rng.next_2d());
+    // A time is drawn only when something moves, so still scenes keep their streams.
+    let ray = if moving { ray.with_time(sample.rng.next_f32()) } else { ray };
+    (ray, sample)
+}
+
+/// What sample `k` of pixel `(x, y)` of `cam` traces, as [`render`] traces it (its integrator, random
+/// numbers and culling from `opts`): the radiance it brings back, in the scene's units, and every
+/// query in order, the camera ray's first ([`RayLog::recording`]).
+pub fn inspect_sample(
+    scene: &Scene,
+    cam: &Camera,
+    opts: &RenderOptions,
+    (x, y, k): (u32, u32, u32),
+) -> (Color, Vec<RayEvent>) {
+    let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
+    let integrator = Integrator::new(scene, cam, opts.renderer.unwrap_or(cam.renderer), cull);
+    let spp = opts.spp.unwrap_or(cam.num_samples).max(1);
+    let (ray, mut sample) =
+        camera_sample(cam, opts, Strata::new(spp), scene.geometry.has_motion(), (x, y, k.min(spp - 1)));
+    let mut log = RayLog::recording();
+    let ray = integrator.camera_ray(&ray);
+    let hit = log.intersect(&scene.geometry, &ray, f32::INFINITY);
+    let color = integrator.li_camera_hit(&ray, hit, &mut sample, &mut log);
+    (color, log.record.unwrap_or_default())
 }
 
 /// The crop window clamped to a `w` x `h` frame, as `(x0, y0, x1, y1)` with `x0 < x1`, `y0 < y1` unless the

@@ -155,13 +155,14 @@ pub fn legend_rows(height: u32) -> u32 {
     (height / 16).clamp(1, 24).min(height)
 }
 
-/// Maps a film of raw costs (red channel) to false colour normalised by its maximum, and draws the
-/// legend bar over the bottom [`legend_rows`] rows (left = no work, right = the maximum). Returns the
-/// maximum cost.
-pub fn heatmap_finish(film: &mut Film) -> u32 {
+/// Maps a film of raw costs (red channel) to false colour normalised by `scale`, else by its maximum,
+/// and draws the legend bar over the bottom [`legend_rows`] rows (left = no work, right = the scale).
+/// Returns the maximum cost.
+pub fn heatmap_finish(film: &mut Film, scale: Option<u32>) -> u32 {
     let max = film.pixels.iter().map(|c| c.x).fold(0.0f32, f32::max);
+    let top = scale.map_or(max, |s| s as f32);
     for c in &mut film.pixels {
-        *c = false_color(if max > 0.0 { c.x / max } else { 0.0 });
+        *c = false_color(if top > 0.0 { (c.x / top).min(1.0) } else { 0.0 });
     }
     let (w, h) = (film.width, film.height);
     for y in h - legend_rows(h)..h {

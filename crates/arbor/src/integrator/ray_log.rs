@@ -5,6 +5,9 @@
 //! timed, so the sample never lines up with them), which leaves the sampling noise of a few
 //! thousand timed queries (well under 1%) on any render long enough to read the figure from. The clock's
 //! own cost, measured once, is taken off each timed query.
+//!
+//! A log can also keep every query it answers ([`RayLog::recording`]): the rays of one pixel's sample,
+//! in the order the integrator traced them, for a live view's ray inspector.
 
 use std::time::{Duration, Instant};
 
@@ -14,6 +17,19 @@ use crate::scene::SceneGeometry;
 
 /// One query in this many is timed.
 pub const TIMED_EVERY: u32 = 64;
+
+/// One query a recording log answered.
+#[derive(Debug, Clone, Copy)]
+pub struct RayEvent {
+    /// The ray.
+    pub ray: Ray,
+    /// The far end of the query's interval.
+    pub t_max: f32,
+    /// A closest-hit query's hit; `None` for a miss and for an any-hit query.
+    pub hit: Option<Hit>,
+    /// `Some(occluded)` for an any-hit (shadow) query.
+    pub occluded: Option<bool>,
+}
 
 /// Rays traced by one worker and the sampled time of their queries.
 #[derive(Debug, Clone, Default)]
@@ -26,6 +42,8 @@ pub struct RayLog {
     pub capped: bool,
     /// Camera samples whose trees reached their budget.
     pub capped_samples: u64,
+    /// Every query answered, when recording ([`RayLog::recording`]).
+    pub record: Option<Vec<RayEvent>>,
     queries: u64,
     timed_queries: u64,
     timed: Duration,
@@ -37,13 +55,26 @@ impl RayLog {
     /// (the integrators count their rays where they decide to trace them).
     #[inline]
     pub fn intersect(&mut self, g: &SceneGeometry, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.query(|| g.intersect(ray, t_max))
+        let hit = self.query(|| g.intersect(ray, t_max));
+        if let Some(r) = &mut self.record {
+            r.push(RayEvent { ray: *ray, t_max, hit, occluded: None });
+        }
+        hit
     }
 
     /// Whether anything lies on `ray` in `(0, t_max)` ([`SceneGeometry::occluded`]); not counted.
     #[inline]
     pub fn occluded(&mut self, g: &SceneGeometry, ray: &Ray, t_max: f32) -> bool {
-        self.query(|| g.occluded(ray, t_max))
+        let occluded = self.query(|| g.occluded(ray, t_max));
+        if let Some(r) = &mut self.record {
+            r.push(RayEvent { ray: *ray, t_max, hit: None, occluded: Some(occluded) });
+        }
+        occluded
+    }
+
+    /// A log that keeps every query it answers, in [`RayLog::record`].
+    pub fn recording() -> RayLog {
+        RayLog { record: Some(Vec::new()), ..RayLog::default() }
     }
 
     /// [`SceneGeometry::intersect_many`], always timed (a batch is worth many clock reads); not counted.
