@@ -65,10 +65,13 @@ pub struct RenderArgs {
     /// (px nx py ny pz nz).
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Skip triangles facing away from camera rays (the course's back-face culling).
+    /// Cull back faces of camera rays: skip the triangles and planes they meet from behind (the course's
+    /// back-face culling). Without --cull or --no-cull the scene decides: its BackfaceCulling element,
+    /// else culling for the 2025 JSON form (its official images are culled) and none for XML and NYU
+    /// JSON files (an XML image most of whose camera rays meet back faces gets a warning naming --cull).
     #[arg(long, conflicts_with = "no_cull")]
     pub cull: bool,
-    /// Never cull back faces, even when the scene asks for it.
+    /// Never cull back faces, even when the scene or its form (2025 JSON) asks for it.
     #[arg(long)]
     pub no_cull: bool,
     /// A debug view instead of the image: boxes[:DEPTH] (the structure's boxes at DEPTH, default 3, as
@@ -203,6 +206,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         crate::outputs::check_writable(file, false)?;
     }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
+    let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
     let scene = Scene::build(desc, &spec, env)?;
     signals.enter(Stage::Render);
     let cull = if args.cull {
@@ -212,6 +216,11 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     } else {
         None
     };
+    if args.quiet < 2 && !args.no_warnings {
+        for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, cull) {
+            eprintln!("warning: {w}");
+        }
+    }
     let base = RenderOptions {
         spp: args.spp,
         cull_backfaces: cull,

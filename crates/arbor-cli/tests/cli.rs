@@ -318,3 +318,27 @@ fn cli_info_describes_the_scene() {
     let out = stdout(&o);
     assert!(out.contains("24x16") && out.contains("sphere") && out.contains("bvh-sah"), "{out}");
 }
+
+#[test]
+fn cli_json_form_culls_by_default_and_no_cull_turns_it_off() {
+    // A wall filling the view with its back to the camera, lit by ambient light only (30 levels):
+    // culled, the image is the black background; unculled, the wall.
+    let files = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_inputs");
+    let tmp = tempfile::tempdir().unwrap();
+    let level = |scene: &str, flags: &[&str]| {
+        let out = tmp.path().join(format!("{scene}{}.png", flags.join("")));
+        let (scene, out_s) = (files.join(scene), out.to_str().unwrap().to_string());
+        let mut args = vec!["render", "-q", scene.to_str().unwrap(), "-o", &out_s];
+        args.extend(flags);
+        let o = arbor(&args, tmp.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (_, _, px) = arbor::image_io::read_rgb8(&out).unwrap();
+        assert!(px.iter().all(|&v| v == px[0]), "one colour");
+        px[0]
+    };
+    assert_eq!(level("back_faces.json", &[]), 0);
+    assert_eq!(level("back_faces.json", &["--no-cull"]), 30);
+    assert_eq!(level("back_faces.json", &["--cull"]), 0);
+    assert_eq!(level("back_faces.xml", &[]), 30);
+    assert_eq!(level("back_faces.xml", &["--cull"]), 0);
+}
