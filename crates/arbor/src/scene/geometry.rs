@@ -192,6 +192,10 @@ pub struct SceneCounts {
     pub objects: usize,
     /// Time spent reading mesh files.
     pub mesh_load: Duration,
+    /// Wall time from the loaded meshes to the finished structures: every mesh's (built in parallel,
+    /// with its vertex normals), the object list and the top level's. Not the sum of the structures'
+    /// own build times, which would count time once per thread that built in parallel.
+    pub build: Duration,
 }
 
 /// The geometry of a scene under its two-level acceleration structure.
@@ -345,11 +349,11 @@ impl SceneGeometry {
     }
 
     /// Statistics of the structures together: the top level plus every distinct mesh's structure
-    /// (counts and bytes summed; depths through both levels; the SAH cost is the top level's plus each
+    /// (counts and bytes summed; the build's wall time, [`SceneCounts::build`]; depths through both levels; the SAH cost is the top level's plus each
     /// mesh's weighted by the share of the scene's area its object covers, an estimate).
     pub fn accel_stats(&self) -> AccelStats {
         let top = self.top.stats();
-        let mut s = AccelStats { primitives: 0, ..top.clone() };
+        let mut s = AccelStats { primitives: 0, build_time: self.counts.build, ..top.clone() };
         let (mut leaf_prims, mut depth_sum, mut refs) = (0.0, 0.0, 0.0);
         let scene_area = self.bounds().area().max(f32::MIN_POSITIVE) as f64;
         let mut mesh_max_depth = 0;
@@ -359,7 +363,6 @@ impl SceneGeometry {
             s.nodes += ms.nodes;
             s.leaves += ms.leaves;
             s.bytes += ms.bytes;
-            s.build_time += ms.build_time;
             mesh_max_depth = mesh_max_depth.max(ms.max_depth);
             leaf_prims += ms.mean_leaf_prims * ms.leaves as f64;
             depth_sum += ms.mean_depth * ms.leaves as f64;
