@@ -380,7 +380,7 @@ fn summary(
         stats.time.as_secs_f64() * 1e3,
         stats.rays as f64 / 1e6,
         stats.mrays_per_s(),
-        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of thread time", f * 100.0))
+        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of CPU time", f * 100.0))
     );
     let s = scene.geometry.accel_stats();
     say!(

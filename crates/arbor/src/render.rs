@@ -31,7 +31,7 @@ use crate::accum::SampleSum;
 use crate::error::Result;
 use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
-use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
+use crate::integrator::{thread_time, DebugIntegrator, DebugView, Integrator, RayLog};
 use crate::renderer::Renderer;
 use crate::sampler::{SampleStream, SamplerKind, Strata};
 use crate::scene::Scene;
@@ -73,10 +73,11 @@ pub struct RenderOptions {
 pub struct RenderStats {
     /// Rays traced: camera, shadow and secondary.
     pub rays: u64,
-    /// The time the structure's queries took, summed over threads (estimated from a sample of them:
-    /// [`RayLog`]).
+    /// The time the structure's queries took, summed over threads (estimated from a sample of them,
+    /// each tile's capped at its CPU time: [`RayLog`]).
     pub traversal: Duration,
-    /// The time the workers spent on tiles, summed over threads.
+    /// The CPU time the workers spent on tiles, summed over threads: not the time they waited for a
+    /// core, nor for work.
     pub busy: Duration,
     /// Wall time.
     pub time: Duration,
@@ -96,8 +97,9 @@ impl RenderStats {
         self.rays as f64 / self.time.as_secs_f64().max(1e-9) / 1e6
     }
 
-    /// The share of the workers' time spent in the structure's queries (the rest is shading, sampling
-    /// and the render loop), or `None` when nothing was traced.
+    /// The share of the workers' CPU time on tiles spent in the structure's queries (the rest is
+    /// shading, sampling and the render loop), or `None` when nothing was traced. Other programs that
+    /// take the cores change it little ([`RayLog`]: within a few points on a loaded 2-core machine).
     pub fn traversal_share(&self) -> Option<f64> {
         (self.busy > Duration::ZERO && self.traversal > Duration::ZERO)
             .then(|| (self.traversal.as_secs_f64() / self.busy.as_secs_f64()).min(1.0))
@@ -196,7 +198,7 @@ fn sums_buffer(window: (u32, u32, u32, u32)) -> Result<Vec<SampleSum>> {
 /// Bytes of one pixel's exact sample sums.
 const SUM_BYTES: u64 = std::mem::size_of::<SampleSum>() as u64;
 
-/// Per-tile sums over the crop window: `((x0, y0, tile width), sums, the tile's rays, its time)`, the stats
+/// Per-tile sums over the crop window: `((x0, y0, tile width), sums, the tile's rays, its CPU time)`, the stats
 /// and the radiance scale.
 type Traced = Vec<((u32, u32, u32), Vec<SampleSum>, RayLog, Duration)>;
 
@@ -238,8 +240,10 @@ fn trace(
             // Every tile's sums are kept until the image is assembled: together, one per pixel.
             let mut pixels =
                 sums_buffer((x0, y0, x1, y1)).map_err(|_| out_of_memory(cx1 - cx0, cy1 - cy0, total * SUM_BYTES))?;
-            let tile_start = Instant::now();
-            let mut log = RayLog::default();
+            let tile_start = thread_time();
+            // A phase per tile (a hash of its place), so that small tiles' queries get timed too.
+            let mut log =
+                RayLog::with_phase((x0 / TILE).wrapping_mul(0x9E37_79B1) ^ (y0 / TILE).wrapping_mul(0x85EB_CA6B));
             let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
@@ -284,20 +288,20 @@ fn trace(
             }
             let n = done.fetch_add(pixels.len() as u64, Ordering::Relaxed) + pixels.len() as u64;
             progress(n, total);
-            Ok(((x0, y0, x1 - x0), pixels, log, tile_start.elapsed()))
+            Ok(((x0, y0, x1 - x0), pixels, log, thread_time().saturating_sub(tile_start)))
         })
         .collect();
     let traced = traced?;
     let cancelled = is_cancelled();
-    let mut log = RayLog::default();
-    let mut busy = Duration::ZERO;
-    for (_, _, l, t) in &traced {
-        log.merge(l);
-        busy += *t;
+    let (mut rays, mut traversal, mut busy) = (0, Duration::ZERO, Duration::ZERO);
+    for (_, _, log, cpu) in &traced {
+        rays += log.rays;
+        traversal += log.traversal_within(*cpu);
+        busy += *cpu;
     }
     let stats = RenderStats {
-        rays: log.rays,
-        traversal: log.traversal(),
+        rays,
+        traversal,
         busy,
         time: start.elapsed(),
         spp,
@@ -407,5 +411,13 @@ mod tests {
         let half = back_face_share(&walls(back, right_front), 0);
         assert_eq!(half, 0.5);
         assert!(half <= BACK_FACE_WARNING_SHARE);
+    }
+
+    #[test]
+    fn render_stats_traversal_is_within_the_tiles_cpu_time() {
+        let scene = walls("1 2 3 1 3 4", "2 5 6 2 6 3");
+        let (_, stats) = render(&scene, 0, &RenderOptions { spp: Some(16), ..Default::default() }, &|_, _| {}).unwrap();
+        assert!(stats.traversal > Duration::ZERO && stats.traversal <= stats.busy, "{stats:?}");
+        assert!(stats.traversal_share().is_some_and(|s| s > 0.0 && s <= 1.0));
     }
 }

@@ -8,7 +8,7 @@ mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};
 pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
-pub use ray_log::{RayLog, TIMED_EVERY};
+pub use ray_log::{thread_time, RayLog, TIMED_EVERY};
 pub use whitted::Whitted;
 
 use crate::accel::Hit;
