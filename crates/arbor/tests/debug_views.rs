@@ -98,7 +98,9 @@ fn debug_primid_identical_across_structures_on_reference_scenes() {
                 let stride = (work / WORK_BUDGET).sqrt().ceil() as u32;
                 let cam = &desc.cameras[0];
                 let camera = arbor::scene::build_camera(cam);
-                let integrator = arbor::integrator::DebugIntegrator::new(&scene, DebugView::PrimId, false);
+                // Culled as `render` culls without an option: as the scene (or its form) says.
+                let cull = scene.cull_backfaces.unwrap_or(false);
+                let integrator = arbor::integrator::DebugIntegrator::new(&scene, DebugView::PrimId, cull);
                 let mut sampled = 0;
                 for y in (0..cam.height).step_by(stride as usize) {
                     for x in (0..cam.width).step_by(stride as usize) {
