@@ -74,8 +74,10 @@ pub struct RenderArgs {
     /// Never cull back faces, even when the scene or its form (2025 JSON) asks for it.
     #[arg(long)]
     pub no_cull: bool,
-    /// A debug view instead of the image: boxes[:DEPTH] (the structure's boxes at DEPTH, default 3, as
-    /// wireframe over the render), heatmap (nodes visited + primitives tested per pixel, false colour,
+    /// A debug view instead of the image: boxes[:DEPTH] (wireframe over the render of the nodes DEPTH
+    /// levels below the root of each structure: the top level's over the objects and each mesh's own;
+    /// 0 is the root's box, the default 3; the levels are those the render summary's and `arbor info`'s
+    /// depths count, a BVH's binary tree's, so DEPTH = its depth max shows the deepest leaves), heatmap (nodes visited + primitives tested per pixel, false colour,
     /// legend along the bottom, maximum printed), primid (a colour per primitive), normal.
     #[arg(long, value_name = "VIEW")]
     pub debug: Option<DebugView>,
