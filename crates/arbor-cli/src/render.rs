@@ -68,7 +68,8 @@ pub struct RenderArgs {
     /// Cull back faces of camera rays: skip the triangles and planes they meet from behind (the course's
     /// back-face culling). Without --cull or --no-cull the scene decides: its BackfaceCulling element,
     /// else culling for the 2025 JSON form (its official images are culled) and none for XML and NYU
-    /// JSON files (an XML image most of whose camera rays meet back faces gets a warning naming --cull).
+    /// JSON files (an XML image most of whose camera rays meet back faces gets a warning naming
+    /// --cull: the XML form does not say its year, and some years' images are culled).
     #[arg(long, conflicts_with = "no_cull")]
     pub cull: bool,
     /// Never cull back faces, even when the scene or its form (2025 JSON) asks for it.

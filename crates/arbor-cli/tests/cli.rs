@@ -341,6 +341,18 @@ fn cli_json_form_culls_by_default_and_no_cull_turns_it_off() {
     assert_eq!(level("back_faces.json", &["--cull"]), 0);
     assert_eq!(level("back_faces.xml", &[]), 30);
     assert_eq!(level("back_faces.xml", &["--cull"]), 0);
+    // `info` says which default applies, and gives the render's warning.
+    let info = |scene: &str| stdout(&arbor(&["info", files.join(scene).to_str().unwrap()], tmp.path()));
+    let json = info("back_faces.json");
+    assert!(json.contains("back-face culling on") && !json.contains("meet back faces"), "{json}");
+    let xml = info("back_faces.xml");
+    assert!(xml.contains("back-face culling off (unless render --cull)"), "{xml}");
+    assert!(
+        xml.contains(
+            "Camera 1: 100% of camera rays meet back faces; if the scene expects back-face culling, render with --cull"
+        ),
+        "{xml}"
+    );
 }
 
 /// A scene of eight inline meshes (bumpy grids of 2x60x60 triangles), built in parallel.

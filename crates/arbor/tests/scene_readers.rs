@@ -268,6 +268,7 @@ fn readers_nyu_parallelogram_and_located_errors() {
     std::fs::write(&path, text).unwrap();
     let d = load_desc(&path).unwrap();
     assert_eq!((d.radiance_scale, d.max_depth, d.shadow_epsilon, d.shadows), (1.0, 0, 1e-4, false));
+    assert_eq!((d.flip_back_faces, d.cull_backfaces), (true, Some(false)));
     assert!(d.cameras[0].orthographic);
     assert_eq!(d.cameras[0].image_name, "quad.png");
     let glass = MaterialKind::Transparent { eta: 1.3, transparency: Vec3::splat(0.5), mirror: Vec3::ZERO };

@@ -47,7 +47,8 @@ pub struct SceneDesc {
     /// is lit by the lights in front of it. NYU scenes turn them.
     pub flip_back_faces: bool,
     /// Back-face culling of primary rays as the scene asks for it (`BackfaceCulling`) or its form implies
-    /// (the 2025 METU JSON form culls); `None` leaves it to the user (no culling by default).
+    /// (the 2025 METU JSON form culls, the NYU form does not); `None` (METU XML) leaves it to the user:
+    /// no culling by default.
     pub cull_backfaces: Option<bool>,
     /// One image per camera.
     pub cameras: Vec<CameraDesc>,
