@@ -38,11 +38,16 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
     say!("scene      {}", crate::shown(&args.scene));
     say!(
-        "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",
+        "settings   background {}  ambient {}  max depth {}  shadow epsilon {}  back-face culling {}",
         desc.background,
         desc.ambient,
         desc.max_depth,
-        desc.shadow_epsilon
+        desc.shadow_epsilon,
+        match desc.cull_backfaces {
+            Some(true) => "on",
+            Some(false) => "off",
+            None => "off (unless render --cull)",
+        }
     );
     for c in &desc.cameras {
         say!(
@@ -119,7 +124,12 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     for w in crate::warnings::scene_warnings(&desc).into_iter().chain(dark) {
         say!("warning    {w}");
     }
+    let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
     let scene = Scene::build(desc, &spec, None)?;
+    let cameras: Vec<usize> = (0..scene.cameras.len()).collect();
+    for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, None) {
+        say!("warning    {w}");
+    }
     let g = &scene.geometry.counts;
     say!(
         "geometry   {} triangles ({} degenerate), {} spheres, {} planes; bounds {} .. {}; meshes read in {:.1} ms",

@@ -69,14 +69,20 @@ pub struct RenderArgs {
     /// (px nx py ny pz nz).
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Skip triangles facing away from camera rays (the course's back-face culling).
+    /// Cull back faces of camera rays: skip the triangles and planes they meet from behind (the course's
+    /// back-face culling). Without --cull or --no-cull the scene decides: its BackfaceCulling element,
+    /// else culling for the 2025 JSON form (its official images are culled) and none for XML and NYU
+    /// JSON files (an XML image most of whose camera rays meet back faces gets a warning naming
+    /// --cull: the XML form does not say its year, and some years' images are culled).
     #[arg(long, conflicts_with = "no_cull")]
     pub cull: bool,
-    /// Never cull back faces, even when the scene asks for it.
+    /// Never cull back faces, even when the scene or its form (2025 JSON) asks for it.
     #[arg(long)]
     pub no_cull: bool,
-    /// A debug view instead of the image: boxes[:DEPTH] (the structure's boxes at DEPTH, default 3, as
-    /// wireframe over the render), heatmap (nodes visited + primitives tested per pixel, false colour,
+    /// A debug view instead of the image: boxes[:DEPTH] (wireframe over the render of the nodes DEPTH
+    /// levels below the root of each structure: the top level's over the objects and each mesh's own;
+    /// 0 is the root's box, the default 3; the levels are those the render summary's and `arbor info`'s
+    /// depths count, a BVH's binary tree's, so DEPTH = its depth max shows the deepest leaves), heatmap (nodes visited + primitives tested per pixel, false colour,
     /// legend along the bottom, maximum printed), primid (a colour per primitive), normal.
     #[arg(long, value_name = "VIEW")]
     pub debug: Option<DebugView>,
@@ -217,6 +223,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         crate::memory::reserve_run(&cams, &targets, args.crop, args.debug.is_none())?;
     }
     let env = args.env.as_deref().map(EnvMap::load).transpose()?;
+    let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
     let scene = Scene::build(desc, &spec, env)?;
     let warn = args.quiet < 2 && !args.no_warnings;
     let whitted = args.debug.is_none_or(|v| v.shades())
@@ -235,6 +242,11 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     } else {
         None
     };
+    if args.quiet < 2 && !args.no_warnings {
+        for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, cull) {
+            eprintln!("warning: {w}");
+        }
+    }
     let base = RenderOptions {
         spp: args.spp,
         cull_backfaces: cull,
@@ -401,7 +413,7 @@ fn summary(
         stats.time.as_secs_f64() * 1e3,
         stats.rays as f64 / 1e6,
         stats.mrays_per_s(),
-        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of thread time", f * 100.0))
+        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of CPU time", f * 100.0))
     );
     let s = scene.geometry.accel_stats();
     say!(

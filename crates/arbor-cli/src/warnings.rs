@@ -2,14 +2,17 @@
 //! unused properties) and three checks of the description: a scene with no objects (every image is the
 //! background), a camera whose up vector is parallel to its gaze (the image's rotation about the
 //! gaze is then undefined), and a path-traced camera in a scene where no path can find light (every
-//! object is black); and two about Whitted ray trees too large for their budget
+//! object is black). Once the scene is built, checks of what the cameras see: an unculled image most
+//! of whose camera rays meet back faces (a scene made for back-face culling, which the XML form cannot
+//! say it is: [`back_faces`]); and two about Whitted ray trees too large for their budget
 //! ([`arbor::integrator::TreePlan`]): before the render, when a sample may need more rays than it allows,
 //! and after it, when samples did.
 
 use arbor::integrator::{TreePlan, TREE_BUDGET};
-use arbor::render::RenderStats;
+use arbor::render::{back_face_share, RenderStats, BACK_FACE_WARNING_SHARE};
 use arbor::renderer::Renderer;
 use arbor::scene::{CameraDesc, Scene, SceneDesc};
+use arbor::Location;
 
 /// Every warning about `desc`, in file order of the readers' and then the checks'.
 pub fn scene_warnings(desc: &SceneDesc) -> Vec<String> {
@@ -71,4 +74,27 @@ pub fn dark_path_tracing(desc: &SceneDesc, cam: &CameraDesc, renderer: Renderer,
         return None;
     };
     Some(format!("{}: Camera {}: the path tracer finds no light: {why}; every object renders black", cam.loc, cam.id))
+}
+
+/// A warning for each of `cameras` (indices into `scene.cameras`, declared at `locs`) most of whose
+/// camera rays meet back faces, when nothing chose the culling (`--cull`/`--no-cull`, the scene's
+/// `BackfaceCulling`, its form's default) and the render is therefore unculled.
+pub fn back_faces(scene: &Scene, cameras: &[usize], locs: &[Location], cull: Option<bool>) -> Vec<String> {
+    if cull.or(scene.cull_backfaces).is_some() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for &c in cameras {
+        let share = back_face_share(scene, c);
+        if share > BACK_FACE_WARNING_SHARE {
+            out.push(format!(
+                "{}: Camera {}: {:.0}% of camera rays meet back faces; if the scene expects back-face culling, \
+                 render with --cull",
+                locs[c],
+                scene.cameras[c].id,
+                share * 100.0
+            ));
+        }
+    }
+    out
 }

@@ -182,6 +182,13 @@ fn catalogue() -> Vec<Row> {
     cmd(&["render", "unknown_element.xml", "--no-warnings", "-o", "OUT"], 0, ""),
     // A camera whose up is parallel to its gaze.
     render("up_parallel_to_gaze.xml", 0, "warning: up_parallel_to_gaze.xml:3:9: Camera 1: Up [0, 0, 2] is parallel to Gaze [0, 0, -1]: the image's orientation is undefined\n"),
+    // Most camera rays meet back faces in an unculled XML render (the form does not say whether it
+    // expects culling): a warning naming --cull, unless a flag chose. The 2025 JSON form culls.
+    render("back_faces.xml", 0, "warning: back_faces.xml:3:9: Camera 1: 100% of camera rays meet back faces; if the scene expects back-face culling, render with --cull\n"),
+    cmd(&["render", "back_faces.xml", "--cull", "-o", "OUT"], 0, ""),
+    cmd(&["render", "back_faces.xml", "--no-cull", "-o", "OUT"], 0, ""),
+    render("back_faces.json", 0, ""),
+    cmd(&["render", "back_faces.json", "--no-cull", "-o", "OUT"], 0, ""),
     // Empty scenes: no camera is an error; no objects renders the background.
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),

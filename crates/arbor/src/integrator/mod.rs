@@ -10,7 +10,7 @@ mod whitted;
 pub use debug::{DebugIntegrator, DebugView};
 pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
 pub use prune::{Pruning, TreePlan, PRUNED_LEVELS, TREE_BUDGET};
-pub use ray_log::{RayEvent, RayLog, TIMED_EVERY};
+pub use ray_log::{thread_time, RayEvent, RayLog, TIMED_EVERY};
 pub use whitted::Whitted;
 
 use crate::accel::Hit;

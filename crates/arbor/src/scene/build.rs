@@ -208,6 +208,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     let start = Instant::now();
     let files = load_mesh_files(desc)?;
     let mesh_load = start.elapsed();
+    let build_start = Instant::now();
 
     // One shape per mesh object, built in parallel; instances point at their base's.
     let mesh_objects: Vec<usize> =
@@ -284,6 +285,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     counts.planes = planes.len();
     counts.objects = objects.len();
     let top = top_level(spec).build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
+    counts.build = build_start.elapsed();
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
 }
 
