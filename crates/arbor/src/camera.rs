@@ -181,6 +181,11 @@ impl Camera {
     /// The same camera (window, lens, settings) moved to look from `eye` along `gaze` with `up`, making a
     /// `width` x `height` image: a live view's camera, moved by the user, at a resolution of its own.
     pub fn posed(&self, eye: Vec3, gaze: Vec3, up: Vec3, width: u32, height: u32) -> Camera {
+        // The camera's own pose keeps its basis to the bit (rebuilt, it could differ in the last bits),
+        // so that an unmoved view renders exactly as `arbor render` does.
+        if (eye, gaze, up) == (self.eye, self.gaze(), self.up()) {
+            return Camera { width, height, ..self.clone() };
+        }
         Camera {
             id: self.id.clone(),
             image_name: self.image_name.clone(),
