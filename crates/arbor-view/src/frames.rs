@@ -3,8 +3,8 @@
 //! A view ([`ViewRequest`]) is a camera of the scene moved by the user ([`arbor::camera::Camera::posed`]),
 //! an integrator, an overlay and a sample budget. Its render runs in passes, each an ordinary
 //! [`render_camera`] of one sample per pixel: first the whole frame at a quarter of the resolution (a
-//! picture within milliseconds while the camera moves), then the overlay (one of the renderer's debug
-//! views, at full resolution), then full-resolution passes with seeds 0, 1, 2, ... whose films are
+//! picture within milliseconds while the camera moves; skipped while full passes take under 40 ms),
+//! then the overlay (one of the renderer's debug views, at full resolution), then full-resolution passes with seeds 0, 1, 2, ... whose films are
 //! averaged, each average published as it lands, until the budget is spent.
 //!
 //! A new view cancels the pass in flight through the renderer's own cancel flag (tiles not yet started
@@ -30,6 +30,9 @@ use crate::structures::{Events, Structures};
 
 /// Frames smaller than this many pixels skip the low-resolution first pass.
 const PREVIEW_MIN_PIXELS: u32 = 64 * 64;
+/// Nor is there a preview while full passes of the view's size take less than this (milliseconds): the
+/// full frame comes about as soon.
+const PREVIEW_UNDER_MS: f64 = 40.0;
 
 /// One view of the scene, as the page asks for it.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,6 +94,8 @@ pub struct Frames {
     job: Mutex<Job>,
     wake: Condvar,
     seq: AtomicU64,
+    /// The size and wall time of the last full-resolution pass.
+    last_pass: Mutex<Option<((u32, u32), f64)>>,
     /// The last image of the view's render.
     pub render: watch::Sender<Option<Arc<Image>>>,
     /// The last overlay image.
@@ -106,6 +111,7 @@ impl Frames {
             job: Mutex::new(Job { version: 0, request: None, cancel: Arc::new(AtomicBool::new(false)) }),
             wake: Condvar::new(),
             seq: AtomicU64::new(0),
+            last_pass: Mutex::new(None),
             render: watch::channel(None).0,
             overlay: watch::channel(None).0,
             events,
@@ -165,7 +171,10 @@ impl Frames {
         let fail = |e: arbor::Error| {
             let _ = self.events.send(json!({"type": "error", "view": version, "error": e.to_string()}).to_string());
         };
-        if w * h >= PREVIEW_MIN_PIXELS {
+        // A preview is worth its time only when a full pass is slow: the last one of this size decides.
+        let last = *self.last_pass.lock().unwrap_or_else(|e| e.into_inner());
+        let fast = last.is_some_and(|(size, ms)| size == (w, h) && ms < PREVIEW_UNDER_MS);
+        if w * h >= PREVIEW_MIN_PIXELS && !fast {
             let small = posed((w / 4).max(1), (h / 4).max(1));
             match render_camera(&scene, &small, &opts, &|_, _| {}) {
                 Ok((film, stats)) if !stale() => publish(
@@ -196,6 +205,7 @@ impl Frames {
                     Ok(_) => return,
                     Err(e) => return fail(e),
                 };
+            *self.last_pass.lock().unwrap_or_else(|e| e.into_inner()) = Some(((w, h), stats.time.as_secs_f64() * 1e3));
             let start = Instant::now();
             sum.iter_mut().zip(&film.pixels).for_each(|(s, p)| *s += *p);
             let n = (k + 1) as f32;

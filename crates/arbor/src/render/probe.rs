@@ -57,7 +57,7 @@ pub const BACK_FACE_WARNING_SHARE: f64 = 0.5;
 
 /// The share of camera `camera`'s rays whose first hit is a back face: a hit that back-face culling
 /// would skip (a triangle or plane met from behind). Estimated apart from any render, from the rays
-/// through the centres of at most [`FACING_GRID`]² pixels spread evenly over the image (mid-shutter,
+/// through the centres of at most 64² (`FACING_GRID`) pixels spread evenly over the image (mid-shutter,
 /// through the lens centre), each traced with and without culling: 8,192 queries at most, 1 to 6 ms on
 /// the shared scenes, plenty to tell "most" from "some". The image itself is not touched.
 pub fn back_face_share(scene: &Scene, camera: usize) -> f64 {

@@ -29,7 +29,7 @@ impl SceneGeometry {
 
     /// Statistics of the structures together: the top level plus every distinct mesh's structure.
     /// Counts and bytes are summed; the build time is the wall time of the whole build
-    /// ([`SceneCounts::build`]); depths are counted within each structure from its own root (the
+    /// ([`super::SceneCounts::build`]); depths are counted within each structure from its own root (the
     /// deepest leaf of any, the mean over all their leaves), as the boxes view counts them
     /// ([`SceneGeometry::boxes_at_depth`]); the SAH cost is the top level's plus each mesh's weighted
     /// by the share of the scene's area its object covers (an estimate).
