@@ -4,8 +4,9 @@
 //! an integrator, an overlay and a sample budget. Its render runs in passes, each an ordinary
 //! [`render_camera`] of one sample per pixel: first the whole frame at a quarter of the resolution (a
 //! picture within milliseconds while the camera moves; skipped while full passes take under 40 ms),
-//! then the overlay (one of the renderer's debug views, at full resolution), then full-resolution passes with seeds 0, 1, 2, ... whose films are
-//! averaged, each average published as it lands, until the budget is spent.
+//! then the overlay (one of the renderer's debug views, at full resolution), then full-resolution
+//! passes with seeds 0, 1, 2, ... whose films are averaged, each average published as it lands, until
+//! the budget is spent.
 //!
 //! A new view cancels the pass in flight through the renderer's own cancel flag (tiles not yet started
 //! are skipped; a tile takes well under a millisecond at these sizes), so the worker moves on at once.
