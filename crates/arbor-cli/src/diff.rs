@@ -33,6 +33,9 @@ pub struct DiffArgs {
     /// level, with every channel's mean signed difference within 2 levels.
     #[arg(long, num_args = 2, value_names = ["SEED_A", "SEED_B"])]
     pub noise: Option<Vec<PathBuf>>,
+    /// Lift the limit on the pixels of each image (2^28, the most `arbor render` writes by default).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Parses `--max-off`: a percentage from 0 to 100 (a NaN limit would pass every image).
@@ -55,11 +58,12 @@ fn parse_block(s: &str) -> Result<u32, String> {
 
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
+    let limits = crate::render::limits(args.no_limits).rendered();
     if let Some(seeds) = &args.noise {
-        let (w, h, reference) = arbor::image_io::read_rgb8(&args.reference)?;
+        let (w, h, reference) = arbor::image_io::read::<u8>(&args.reference, &limits)?;
         let mut images = Vec::new();
         for path in [&args.image, &seeds[0], &seeds[1]] {
-            let (pw, ph, px) = arbor::image_io::read_rgb8(path)?;
+            let (pw, ph, px) = arbor::image_io::read::<u8>(path, &limits)?;
             if (pw, ph) != (w, h) {
                 let msg = format!("{} is {pw}x{ph} but the reference is {w}x{h}", path.display());
                 return Err(arbor::Error::Invalid(msg).into());
@@ -73,13 +77,13 @@ pub fn run(args: DiffArgs) -> Result<(), Failure> {
     }
     let (share_off, what) = match args.block {
         None => {
-            let c = compare_files(&args.reference, &args.image, args.threshold)?;
+            let c = compare_files(&args.reference, &args.image, args.threshold, &limits)?;
             say!("{}", c.summary());
             say!("{}", c.bias_summary());
             (c.share_off, "pixels".to_string())
         }
         Some(k) => {
-            let c = compare_blocks_files(&args.reference, &args.image, k, args.threshold)?;
+            let c = compare_blocks_files(&args.reference, &args.image, k, args.threshold, &limits)?;
             say!("{}", c.summary());
             say!("{}", c.bias_summary());
             (c.share_off, format!("blocks of {k}x{k} pixels"))

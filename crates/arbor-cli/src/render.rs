@@ -96,7 +96,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_warnings: bool,
     /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
-    /// depth (64) and pixels x samples (2^34) that guard against crafted scene files.
+    /// depth (64), pixels x samples (2^34) and the pixels of each image the scene reads (2^26: textures,
+    /// environment maps, cube faces, --env) that guard against crafted scene files.
     #[arg(long)]
     pub no_limits: bool,
 }
@@ -178,7 +179,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             cameras.len()
         )));
     }
-    check_limits(&desc, args.spp, &limits(args.no_limits))?;
+    let limits = limits(args.no_limits);
+    check_limits(&desc, args.spp, &limits)?;
     if let Some((_, _, x1, y1)) = args.crop {
         if let Some(cam) = cameras.iter().map(|&c| &desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
             return Err(arbor::Error::Invalid(format!(
@@ -202,8 +204,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     if let Some(file) = &args.stats_json {
         crate::outputs::check_writable(file, false)?;
     }
-    let env = args.env.as_deref().map(EnvMap::load).transpose()?;
-    let scene = Scene::build(desc, &spec, env)?;
+    let env = args.env.as_deref().map(|p| EnvMap::load(p, &limits.images)).transpose()?;
+    let scene = Scene::build_within(desc, &spec, env, &limits.images)?;
     signals.enter(Stage::Render);
     let cull = if args.cull {
         Some(true)
