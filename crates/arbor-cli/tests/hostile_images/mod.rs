@@ -95,6 +95,9 @@ pub fn rows() -> Vec<Row> {
     // --no-limits: an image one row over the budget renders; the bomb fails cleanly for want of memory.
     cmd(&["render", "texture_big.xml", "--no-limits", "-o", "OUT"], 0, ""),
     cmd(&["render", "env_bomb.xml", "--no-limits", "-o", "OUT"], 3, "error: env_bomb.xml:14:43: cannot read environment map 'bomb.png': not enough memory to convert it: 20000x20000 pixels (4.5 GiB)\n"),
+    // NaN and infinite texels: refused, naming the first.
+    render("env_nan.xml", 3, "error: env_nan.xml:14:43: cannot read environment map 'nan.exr': pixel (1, 0) is not finite: (NaN, 0.5, 0.5)\n"),
+    render("texture_inf.xml", 3, "error: texture_inf.xml:24:17: cannot read texture image 'inf.exr': pixel (0, 1) is not finite: (inf, 0.5, 0.5)\n"),
     // diff and merge: the film's limit, 2^28 pixels (what render may write).
     cmd(&["diff", "bomb.png", "tex.png"], 3, error(format!("bomb.png: {bomb_file}"))),
     cmd(&["diff", "tex.png", "bomb.png", "--no-limits"], 4, "error: bomb.png: not enough memory to convert it: 20000x20000 pixels (1.1 GiB)\n"),

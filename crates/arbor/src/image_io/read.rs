@@ -140,6 +140,16 @@ fn decode_samples(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<(u3
     Ok((width, height, color, samples))
 }
 
+/// Refuses an image `width` pixels wide (read from `path`) holding a NaN or an infinity, naming the
+/// first pixel that does: what needs radiance or float texels calls this, as float files can hold them.
+pub fn check_finite(pixels: impl IntoIterator<Item = [f32; 3]>, width: u32, path: &Path) -> Result<()> {
+    let Some((i, [r, g, b])) = pixels.into_iter().enumerate().find(|(_, p)| !p.iter().all(|v| v.is_finite())) else {
+        return Ok(());
+    };
+    let (x, y) = (i as u64 % width.max(1) as u64, i as u64 / width.max(1) as u64);
+    Err(Error::input(Location::file(path), format!("pixel ({x}, {y}) is not finite: ({r}, {g}, {b})")))
+}
+
 /// The error of a decoder.
 pub(super) fn undecodable(path: &Path, e: image::ImageError) -> Error {
     let why = match e {
@@ -216,6 +226,17 @@ mod tests {
             assert_eq!(floats.len(), whole.len());
             assert_eq!(bytes8, image.into_rgb8().into_raw(), "{color:?}");
         }
+    }
+
+    #[test]
+    fn check_finite_names_the_first_pixel_that_is_not() {
+        let path = Path::new("sky.exr");
+        check_finite([[0.0, 1e30, -2.0]; 4], 2, path).unwrap();
+        let pixels = [[0.0; 3], [0.0; 3], [0.0; 3], [1.0, f32::NAN, 0.5], [f32::INFINITY; 3]];
+        let e = check_finite(pixels, 2, path).unwrap_err().to_string();
+        assert_eq!(e, "sky.exr: pixel (1, 1) is not finite: (1, NaN, 0.5)");
+        let e = check_finite([[f32::NEG_INFINITY, 0.0, 0.0]], 1, path).unwrap_err().to_string();
+        assert_eq!(e, "sky.exr: pixel (0, 0) is not finite: (-inf, 0, 0)");
     }
 
     #[test]

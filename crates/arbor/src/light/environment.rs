@@ -2,7 +2,7 @@
 //! ray that leaves the scene. Either one latitude-longitude image or a cube map of six square faces.
 //!
 //! Values are in display units, exactly what [`read_image_within`] gives (8-bit files divided by 255, EXR
-//! and HDR as stored). Lookups are bilinear.
+//! and HDR as stored), and finite: a file holding a NaN or an infinity is refused. Lookups are bilinear.
 //! [`EnvMap::eval`] takes any non-zero finite direction, unit or not, and returns black for a zero,
 //! infinite or NaN one.
 //!
@@ -51,7 +51,7 @@ use std::sync::Arc;
 
 use crate::error::{Error, Location, Result};
 use crate::film::Film;
-use crate::image_io::{read_image_within, ImageLimits};
+use crate::image_io::{check_finite, read_image_within, ImageLimits};
 use crate::math::{Color, Vec3};
 
 /// Face labels in storage order, the order of [`EnvMap::from_faces`].
@@ -86,7 +86,7 @@ enum Kind {
 
 impl EnvMap {
     /// Loads a map: an image file is a latitude-longitude map, a directory a cube map whose faces are
-    /// found by name. Each image is held to `limits`. Errors name the file,
+    /// found by name. Each image is held to `limits` and must hold finite values. Errors name the file,
     /// or list the faces a directory lacks.
     pub fn load(spec: &Path, limits: &ImageLimits) -> Result<EnvMap> {
         if spec.is_dir() {
@@ -178,9 +178,12 @@ fn cube(faces: [Film; 6]) -> EnvMap {
     EnvMap { kind: Arc::new(Kind::Cube { size: faces[0].width, faces: Box::new(faces) }) }
 }
 
-/// An image of a map.
+/// An image of a map: radiance, so a NaN or an infinity (which a float file can hold) is refused; it
+/// would reach every pixel whose rays see it, and the estimates of every point it lights.
 fn read_map(path: &Path, limits: &ImageLimits) -> Result<Film> {
-    read_image_within(path, limits)
+    let film = read_image_within(path, limits)?;
+    check_finite(film.pixels.iter().map(|c| c.to_array()), film.width, path)?;
+    Ok(film)
 }
 
 /// The first face that is not square, empty, inconsistent or of another size than face 0.

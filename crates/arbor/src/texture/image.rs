@@ -62,11 +62,12 @@ impl TexImage {
         }
     }
 
-    /// Reads PNG or JPEG as 8-bit texels, EXR and HDR as floats, within `limits`.
+    /// Reads PNG or JPEG as 8-bit texels, EXR and HDR as floats (which must be finite), within `limits`.
     pub fn load(path: &Path, limits: &ImageLimits) -> Result<TexImage> {
         let hdr = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let (w, h, texels) = if matches!(hdr.as_deref(), Some("exr" | "hdr")) {
             let (w, h, texels) = image_io::read::<f32>(path, limits)?;
+            image_io::check_finite(texels.chunks_exact(3).map(|c| [c[0], c[1], c[2]]), w, path)?;
             (w, h, Texels::F32(texels))
         } else {
             let (w, h, bytes) = image_io::read::<u8>(path, limits)?;
