@@ -1,7 +1,7 @@
 //! Inputs found by the fuzz targets (`fuzz/`, see `docs/robustness.md`) that once made a reader or a
 //! structure panic or disagree, kept here with their bytes inline so `cargo test` replays them; and a
-//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files, so every run starts from inputs that
-//! reach past the first error.
+//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files (meshes, scenes, images), so every run
+//! starts from inputs that reach past the first error.
 
 use std::path::{Path, PathBuf};
 
@@ -61,6 +61,34 @@ fn fuzz_seeds_are_valid_scenes() {
             let d = parse_desc(&text, Path::new(name)).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
             assert!(!d.objects.is_empty(), "seed {} has no object", f.display());
         }
+    }
+}
+
+#[test]
+fn fuzz_seeds_are_valid_images() {
+    use arbor::image_io::{decode, ImageLimits};
+    // The budget of the targets (fuzz/fuzz_targets/common.rs).
+    let limits = ImageLimits { max_pixels: 1 << 20 };
+    for (target, name) in [
+        ("decode_png", "fuzz.png"),
+        ("decode_jpeg", "fuzz.jpg"),
+        ("decode_exr", "fuzz.exr"),
+        ("decode_hdr", "fuzz.hdr"),
+        ("decode_ppm", "fuzz.ppm"),
+    ] {
+        for f in seeds(target) {
+            let bytes = std::fs::read(&f).unwrap();
+            let (w, h, colours) = decode::<arbor::math::Color>(&bytes, Path::new(name), &limits)
+                .unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(w > 0 && h > 0 && colours.len() == (w * h) as usize, "seed {}", f.display());
+        }
+    }
+    let partials: Vec<_> =
+        seeds("decode_exr").into_iter().filter(|f| f.to_string_lossy().contains("partial")).collect();
+    assert!(!partials.is_empty());
+    for f in partials {
+        let bytes = std::fs::read(&f).unwrap();
+        arbor::farm::decode_partial(&bytes, &f, &limits).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
     }
 }
 

@@ -95,9 +95,13 @@ const PIXEL_BYTES: usize = 4 * (CHANNELS.len() * 5 + 1);
 /// Reads a partial image written by [`write_partial`], its frame and window held to `limits` (those of
 /// an image `render` may write: [`crate::scene::SceneLimits::rendered`]).
 pub fn read_partial(path: &Path, limits: &ImageLimits) -> Result<Partial> {
-    let bytes = crate::input::load_bytes(path)?;
+    decode_partial(&crate::input::load_bytes(path)?, path, limits)
+}
+
+/// [`read_partial`] of the file `bytes`, named `path` in errors.
+pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<Partial> {
     let bad = |msg: String| Error::input(Location::file(path), msg);
-    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false)
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
         .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
     for header in &meta.headers {
         let frame = header.shared_attributes.display_window.size;
@@ -116,14 +120,10 @@ pub fn read_partial(path: &Path, limits: &ImageLimits) -> Result<Partial> {
         let need = (w as u64).saturating_mul(h as u64).saturating_mul(per_pixel as u64);
         drop(crate::image_io::try_vec::<u8>(need, w as u32, h as u32, "read it", path)?);
     }
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(Cursor::new(bytes))
-        .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
+    let reader = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let reader = if crate::image_io::exr_in_parallel(&meta.headers) { reader } else { reader.non_parallel() };
+    let image =
+        reader.from_buffered(Cursor::new(bytes)).map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
     let layer = &image.layer_data;
     let a = &layer.attributes.other;
     let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());

@@ -26,8 +26,13 @@ use crate::error::{Error, Location, Result, LIFT_LIMITS};
 /// Bytes of all channels of a pixel of the data window, per pixel of the budget.
 const BYTES_PER_PIXEL: u64 = 16;
 
-/// Images with at least this many pixels in their data window are decompressed in parallel.
+/// Images with at least this many pixels in their data windows are decompressed in parallel.
 const PARALLEL: u64 = 1 << 20;
+
+/// Whether a file of these headers is worth decompressing on a pool of threads of its own.
+pub(crate) fn in_parallel(headers: &[Header]) -> bool {
+    headers.iter().map(|h| h.layer_size.area() as u64).sum::<u64>() >= PARALLEL
+}
 
 /// The pixels of the OpenEXR file `bytes` as native-endian float RGB: `(width, height, Rgb32F, bytes)`.
 pub(super) fn decode_rgb(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<(u32, u32, ColorType, Vec<u8>)> {
@@ -68,8 +73,7 @@ pub(super) fn decode_rgb(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Res
         .rgba_channels(|_, _| storage.take().unwrap_or_default(), set)
         .first_valid_layer()
         .all_attributes();
-    let small = (header.layer_size.area() as u64) < PARALLEL;
-    let reader = if small { reader.non_parallel() } else { reader };
+    let reader = if in_parallel(&meta.headers) { reader } else { reader.non_parallel() };
     let image = reader.from_buffered(Cursor::new(bytes)).map_err(bad)?;
     Ok((width as u32, height as u32, ColorType::Rgb32F, image.layer_data.channel_data.pixels))
 }
@@ -92,4 +96,58 @@ fn check_header(header: &Header, path: &Path, limits: &ImageLimits) -> Result<()
         return Err(Error::input(Location::file(path), msg));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image_io::decode;
+    use crate::math::Color;
+
+    /// An EXR of float channels `names` over a data window of `size` at `position` in a `display` frame.
+    fn exr(size: (usize, usize), position: (i32, i32), display: (usize, usize), names: &[&str]) -> Vec<u8> {
+        let n = size.0 * size.1;
+        let sample = |i: usize, k: usize| (i * 10 + k) as f32 * 0.25;
+        let channels: Vec<AnyChannel<FlatSamples>> = (names.iter().enumerate())
+            .map(|(k, name)| AnyChannel::new(*name, FlatSamples::F32((0..n).map(|i| sample(i, k)).collect())))
+            .collect();
+        let attributes = LayerAttributes { layer_position: Vec2(position.0, position.1), ..Default::default() };
+        let layer = Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
+        let mut image = Image::from_layer(layer);
+        image.attributes.display_window = IntegerBounds::new((0, 0), display);
+        let mut bytes = Cursor::new(Vec::new());
+        image.write().to_buffered(&mut bytes).unwrap();
+        bytes.into_inner()
+    }
+
+    #[test]
+    fn openexr_reads_a_data_window_inside_its_display_window_as_the_image_crate_does() {
+        let bytes = exr((3, 2), (1, 2), (5, 4), &["A", "B", "G", "R", "Z"]);
+        let (w, h, ours) = decode::<Color>(&bytes, Path::new("a.exr"), &ImageLimits::DEFAULT).unwrap();
+        let theirs = image::load_from_memory(&bytes).unwrap().into_rgb32f();
+        assert_eq!(((w, h), theirs.dimensions()), ((5, 4), (5, 4)));
+        let ours: Vec<f32> = ours.iter().flat_map(|c| c.to_array()).collect();
+        assert!(ours.iter().zip(theirs.as_raw()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // Black outside the data window; inside, pixel (1, 2) is the window's first (B, G, R = channels 1-3).
+        assert_eq!(ours[..3 * 11], [0.0; 33]);
+        assert_eq!(ours[3 * 11..3 * 12], [0.75, 0.5, 0.25]);
+    }
+
+    #[test]
+    fn openexr_headers_are_held_to_the_budget_by_both_windows_and_the_channel_bytes() {
+        let limits = ImageLimits { max_pixels: 16 };
+        let rgb = ["B", "G", "R"];
+        let e = |bytes: &[u8]| decode::<u8>(bytes, Path::new("a.exr"), &limits).unwrap_err().to_string();
+        assert!(
+            e(&exr((2, 2), (0, 0), (5, 4), &rgb)).starts_with("a.exr: image 5x4 has 20 pixels, more than the limit")
+        );
+        assert!(e(&exr((5, 4), (0, 0), (2, 2), &rgb)).starts_with("a.exr: the data window 5x4 has 20 pixels, more"));
+        assert_eq!(
+            e(&exr((4, 4), (0, 0), (4, 4), &["A", "B", "C", "G", "R"])),
+            "a.exr: the data window 4x4 holds 320 bytes in 5 channels, more than the limit of 256 (16 per pixel of \
+             the limit); --no-limits lifts the limits"
+        );
+        // Four float channels: 16 bytes a pixel, the most the budget takes.
+        decode::<u8>(&exr((4, 4), (0, 0), (4, 4), &["A", "B", "G", "R"]), Path::new("a.exr"), &limits).unwrap();
+    }
 }
