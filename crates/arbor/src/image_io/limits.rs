@@ -10,10 +10,10 @@
 //! still does not fit in memory is an out-of-memory error naming it, never an abort.
 //!
 //! The default, [`ImageLimits::DEFAULT`], is 2^26 pixels (8192 x 8192, or a 16384 x 4096
-//! latitude-longitude map): 20 times the largest image of the course scenes (2000 x 3008, a 6-megapixel
-//! JPEG texture), and at most about 2.3 GB for the largest use (a float environment map: the decoded
-//! samples, the map and its sampling table, 32 bytes a pixel). `arbor --no-limits` lifts it
-//! ([`ImageLimits::NONE`]); the scene's limits hold the value ([`crate::scene::SceneLimits`]).
+//! latitude-longitude map): 11 times the largest image of the course scenes (2000 x 3008, a 6-megapixel
+//! JPEG texture), and at most about 1.6 GB for the largest use (a float environment map: its decoded
+//! samples and the map, 24 bytes a pixel, then the map and its sampling table, 20). `arbor --no-limits`
+//! lifts it ([`ImageLimits::NONE`]); the scene's limits hold the value ([`crate::scene::SceneLimits`]).
 
 use std::path::Path;
 
