@@ -58,16 +58,10 @@ impl Default for ImageLimits {
 }
 
 /// An empty vector with room for `n` items of what a `width` x `height` image of `path` holds (`what`:
-/// "decode it", "its mipmap"), or an out-of-memory I/O error naming the file (the CLI's exit 4; a scene's
+/// "decode it", "convert it"), or an out-of-memory I/O error naming the file (the CLI's exit 4; a scene's
 /// texture or map is located at its element instead, like a mesh file).
 pub(crate) fn try_vec<T>(n: u64, width: u32, height: u32, what: &str, path: &Path) -> Result<Vec<T>> {
-    let mut v = Vec::new();
-    if usize::try_from(n).ok().and_then(|n| v.try_reserve_exact(n).ok()).is_none() {
-        let gib = n as f64 * std::mem::size_of::<T>() as f64 / (1u64 << 30) as f64;
-        let msg = format!("not enough memory to {what}: {width}x{height} pixels ({gib:.1} GiB)");
-        return Err(Error::io(path, std::io::Error::new(std::io::ErrorKind::OutOfMemory, msg)));
-    }
-    Ok(v)
+    crate::input::vec_for(n, path, |gib| format!("not enough memory to {what}: {width}x{height} pixels ({gib:.1} GiB)"))
 }
 
 #[cfg(test)]
