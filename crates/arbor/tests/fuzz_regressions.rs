@@ -93,6 +93,44 @@ fn fuzz_seeds_are_valid_images() {
 }
 
 // ---------------------------------------------------------------------------------------------------
+// decode_png, decode_exr
+
+/// Found by `decode_png` (fuzz/crashes/decode_png/crash-9705..., whose CRCs are corrected here: the png
+/// crate skips them when fuzzing): a 4x2 PNG of 2-bit palette indices whose `PLTE` chunk holds 13 bytes,
+/// four RGB entries and one byte. The png crate (0.18.1) accepts it and panics expanding the palette
+/// (`range end index 3 out of range for slice of length 1`, image-rs/image-png#694). Fixed: the chunks are
+/// walked first and such a palette is refused (`image_io/png.rs`).
+#[test]
+fn fuzz_png_palette_of_part_entries_is_refused_not_a_panic() {
+    #[rustfmt::skip]
+    const PNG: [u8; 75] = [
+    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 4, 0, 0, 0, 2, 2, 3, 0, 0, 0, 2, 198,
+    149, 240, 0, 0, 0, 13, 80, 76, 84, 69, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 155, 58, 33, 251, 173, 255,
+    255, 0, 12, 73, 68, 65, 84, 120, 156, 99, 145, 102, 124, 2, 0, 130,
+    ];
+    let e = arbor::image_io::decode::<u8>(&PNG, Path::new("p.png"), &arbor::image_io::ImageLimits::DEFAULT);
+    let msg = "p.png: cannot decode image: its palette (PLTE) holds 13 bytes, not whole RGB entries";
+    assert_eq!(e.unwrap_err().to_string(), msg);
+}
+
+/// Found by `decode_exr` (fuzz/crashes/decode_exr/crash-ca02...): a 3x2 EXR whose version flags say
+/// tiled (one level of 64x64 tiles) and whose block claims resolution level (0, 1). Read as a partial
+/// (`all_channels`), the exr crate let the block through its level filter and failed its own debug
+/// assertion `line should have been filtered` (without debug assertions it writes the block into level 0).
+/// Fixed: a partial is flat scan lines, so a tiled or deep header is refused before any block is read.
+/// Read as an image it decodes, as the image crate's decoder reads it.
+#[test]
+fn fuzz_exr_tiled_header_is_no_partial() {
+    let bytes = include_bytes!("../../../fuzz/crashes/decode_exr/crash-ca023e370800ff53b40f9dd3a21e40e06479ebf9");
+    let limits = arbor::image_io::ImageLimits { max_pixels: 1 << 20 };
+    let e = arbor::farm::decode_partial(bytes, Path::new("t.exr"), &limits).unwrap_err().to_string();
+    let msg = "t.exr: not a partial image of `arbor render` (it is tiled or deep, a partial is flat scan lines)";
+    assert_eq!(e, msg);
+    let (w, h, _) = arbor::image_io::decode::<u8>(bytes, Path::new("t.exr"), &limits).unwrap();
+    assert_eq!((w, h), (3, 2));
+}
+
+// ---------------------------------------------------------------------------------------------------
 // accel_differential
 
 /// Found by `accel_differential` (minimised): a triangle with one huge corner, hit at `t` when `t_max`

@@ -13,6 +13,8 @@
 //! - `huge.hdr`, `huge.ppm`: Radiance and PPM headers claiming 100000 x 100000.
 //! - `nan.exr`, `inf.exr`: 2 x 2 float images with a NaN and an infinite texel (they rendered).
 //! - `cube/`: six faces, `px.png` the bomb.
+//! - `palette.png`: 4 x 2 pixels of 2-bit palette indices, the palette 13 bytes (four entries and one
+//!   byte): the png crate panicked expanding it (found by the `decode_png` fuzz target).
 //! - `huge_frame.exr`, `big_frame.exr`: partial EXRs of `arbor render` (one pixel rendered) whose frame is
 //!   100000 x 100000, and 16385 x 16385 (just over the film's 2^28 pixels): `merge` allocated the frame
 //!   and aborted.
@@ -47,6 +49,7 @@ pub fn write_all(dir: &Path, catalogue: &Path) {
     };
     arbor::image_io::write_image(&dir.join("nan.exr"), &film(1, f32::NAN)).unwrap();
     arbor::image_io::write_image(&dir.join("inf.exr"), &film(2, f32::INFINITY)).unwrap();
+    palette_png(&dir.join("palette.png"));
     let cube = dir.join("cube");
     std::fs::create_dir(&cube).unwrap();
     std::fs::copy(dir.join("bomb.png"), cube.join("px.png")).unwrap();
@@ -104,6 +107,7 @@ pub fn rows() -> Vec<Row> {
     cmd(&["diff", "tex.png", "huge.exr"], 3, error(format!("huge.exr: {}", over("image", "65536x16384", 1 << 30, 1 << 28)))),
     cmd(&["diff", "tex.png", "huge_window.exr"], 3, error(format!("huge_window.exr: {}", over("the data window", "65536x16384", 1 << 30, 1 << 28)))),
     cmd(&["diff", "tex.png", "huge.hdr"], 3, error(format!("huge.hdr: {}", over("image", "100000x100000", 10_000_000_000, 1 << 28)))),
+    cmd(&["diff", "tex.png", "palette.png"], 3, "error: palette.png: cannot decode image: its palette (PLTE) holds 13 bytes, not whole RGB entries\n"),
     cmd(&["diff", "huge.ppm", "tex.png"], 3, error(format!("huge.ppm: {}", over("image", "100000x100000", 10_000_000_000, 1 << 28)))),
     cmd(&["merge", "huge_frame.exr", "-o", "OUT/merged.png"], 3, error(format!("huge_frame.exr: {}", over("the frame", "100000x100000", 10_000_000_000, 1 << 28)))),
     cmd(&["merge", "big_frame.exr", "-o", "OUT/merged.png"], 3, error(format!("big_frame.exr: {}", over("the frame", "16385x16385", 268_468_225, 1 << 28)))),
@@ -121,6 +125,17 @@ fn bomb_png(path: &Path, w: u32, h: u32) {
     encoder.set_filter(png::Filter::NoFilter);
     let mut writer = encoder.write_header().unwrap();
     writer.write_image_data(&vec![0; w.div_ceil(8) as usize * h as usize]).unwrap();
+    writer.finish().unwrap();
+}
+
+/// A 4 x 2 PNG of 2-bit palette indices whose palette holds 13 bytes, not whole RGB entries.
+fn palette_png(path: &Path) {
+    let mut encoder = png::Encoder::new(std::fs::File::create(path).unwrap(), 4, 2);
+    encoder.set_color(png::ColorType::Indexed);
+    encoder.set_depth(png::BitDepth::Two);
+    encoder.set_palette(vec![0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 155]);
+    let mut writer = encoder.write_header().unwrap();
+    writer.write_image_data(&[0b0001_1011, 0b1110_0100]).unwrap();
     writer.finish().unwrap();
 }
 

@@ -104,6 +104,13 @@ pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
         .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
     for header in &meta.headers {
+        // Tiles (which the exr crate mixes up across resolution levels when a block claims a level the
+        // header has not) are never in a partial.
+        if header.blocks != exr::meta::BlockDescription::ScanLines || header.deep {
+            return Err(bad(
+                "not a partial image of `arbor render` (it is tiled or deep, a partial is flat scan lines)".into(),
+            ));
+        }
         let frame = header.shared_attributes.display_window.size;
         limits.check_area("the frame", frame.width() as u64, frame.height() as u64, path)?;
         let (w, h) = (header.layer_size.width(), header.layer_size.height());
@@ -120,7 +127,9 @@ pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result
         let need = (w as u64).saturating_mul(h as u64).saturating_mul(per_pixel as u64);
         drop(crate::image_io::try_vec::<u8>(need, w as u32, h as u32, "read it", path)?);
     }
+    // Pedantic: a partial is Arbor's own file, and written by the same crate.
     let reader = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let reader = reader.pedantic();
     let reader = if crate::image_io::exr_in_parallel(&meta.headers) { reader } else { reader.non_parallel() };
     let image =
         reader.from_buffered(Cursor::new(bytes)).map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;

@@ -21,6 +21,7 @@ mod limits;
 pub mod metrics;
 pub mod noisy;
 mod openexr;
+mod png;
 mod read;
 pub(crate) mod write;
 

@@ -119,6 +119,12 @@ fn decode_samples(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<(u3
             let msg = "cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)";
             return Err(Error::input(Location::file(path), msg));
         }
+        Some(ImageFormat::Png) => {
+            if let Some(len) = super::png::broken_palette(bytes) {
+                let msg = format!("cannot decode image: its palette (PLTE) holds {len} bytes, not whole RGB entries");
+                return Err(Error::input(Location::file(path), msg));
+            }
+        }
         _ => {}
     }
     // The image crate's own allocation limit (512 MiB) bounds what its decoders allocate besides the
