@@ -103,6 +103,10 @@ pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result
     let bad = |msg: String| Error::input(Location::file(path), msg);
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
         .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
+    let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());
+    if !meta.headers.iter().any(|h| h.own_attributes.other.contains_key(&Text::from("arbor.render"))) {
+        return Err(not_partial());
+    }
     for header in &meta.headers {
         // Tiles (which the exr crate mixes up across resolution levels when a block claims a level the
         // header has not) are never in a partial.
@@ -135,7 +139,6 @@ pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result
         reader.from_buffered(Cursor::new(bytes)).map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
     let layer = &image.layer_data;
     let a = &layer.attributes.other;
-    let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());
     let text = |k: &str| match a.get(&Text::from(k)) {
         Some(AttributeValue::Text(t)) => Some(t.to_string()),
         _ => None,
@@ -202,4 +205,22 @@ pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result
     }
     let sums = RenderSums { frame, window, spp, samples: (k0, k1), scale, sums };
     Ok(Partial { identity, camera, tonemap, sums })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn partial_in_tiles_is_refused_before_its_blocks_are_read() {
+        let mut attributes = LayerAttributes::default();
+        attributes.other.insert(Text::from("arbor.render"), AttributeValue::Text(Text::from("x")));
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32));
+        let layer = Layer::new((2, 2), attributes, Encoding::FAST_LOSSLESS, channels);
+        let mut bytes = Cursor::new(Vec::new());
+        Image::from_layer(layer).write().to_buffered(&mut bytes).unwrap();
+        let e = decode_partial(bytes.get_ref(), Path::new("t.exr"), &ImageLimits::DEFAULT).unwrap_err();
+        let msg = "t.exr: not a partial image of `arbor render` (it is tiled or deep, a partial is flat scan lines)";
+        assert_eq!(e.to_string(), msg);
+    }
 }
