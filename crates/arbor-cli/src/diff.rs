@@ -10,7 +10,7 @@ use arbor::film::Film;
 use arbor::image_io::levels::{BlockLevels, DisplayCurve};
 use arbor::image_io::metrics::{compare_block_levels, compare_blocks_rgb8, compare_rgb8, BlockComparison, Comparison};
 use arbor::image_io::noisy::{compare_noisy, compare_noisy_rgb8};
-use arbor::image_io::{is_hdr_path, read_image, read_rgb8};
+use arbor::image_io::{is_hdr_path, read, read_image_within, ImageLimits};
 use clap::Args;
 
 use crate::Failure;
@@ -44,6 +44,9 @@ pub struct DiffArgs {
     /// difference within 2 levels. --threshold and --max-off do not apply.
     #[arg(long, value_name = "IMAGE_OTHER_SEED")]
     pub noise: Option<PathBuf>,
+    /// Lift the limit on the pixels of each image (2^28, the most `arbor render` writes by default).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Parses `--max-off`: a percentage from 0 to 100 (a NaN limit would pass every image).
@@ -77,11 +80,11 @@ enum Read {
 }
 
 impl Read {
-    fn of(path: &Path) -> Result<Read, Failure> {
+    fn of(path: &Path, limits: &ImageLimits) -> Result<Read, Failure> {
         Ok(if is_hdr_path(path) {
-            Read::Hdr(read_image(path)?)
+            Read::Hdr(read_image_within(path, limits)?)
         } else {
-            let (w, h, px) = read_rgb8(path)?;
+            let (w, h, px) = read::<u8>(path, limits)?;
             Read::Rgb8(w, h, px)
         })
     }
@@ -96,9 +99,9 @@ impl Read {
 
 /// Reads the reference and `images` (each fails as a file first), then checks that they are all 8-bit or
 /// all HDR, and all of one size.
-fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
-    let first = Read::of(reference)?;
-    let rest = images.iter().map(|p| Read::of(p)).collect::<Result<Vec<_>, _>>()?;
+fn read_all(reference: &Path, images: &[&PathBuf], limits: &ImageLimits) -> Result<Images, Failure> {
+    let first = Read::of(reference, limits)?;
+    let rest = images.iter().map(|p| Read::of(p, limits)).collect::<Result<Vec<_>, _>>()?;
     let want = first.size();
     for (path, read) in images.iter().zip(&rest) {
         let (hdr, other) = (matches!(first, Read::Hdr(_)), matches!(read, Read::Hdr(_)));
@@ -180,7 +183,8 @@ impl Images {
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
     let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
-    let images = read_all(&args.reference, &paths)?;
+    let limits = crate::render::limits(args.no_limits).rendered();
+    let images = read_all(&args.reference, &paths, &limits)?;
     if matches!(images, Images::Hdr { .. }) {
         say!(
             "HDR images: compared in 8-bit levels under the reference's curve (key 0.18 of its log-average, gamma 2.2)"

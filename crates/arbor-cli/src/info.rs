@@ -22,7 +22,8 @@ pub struct InfoArgs {
     /// List the acceleration structures and their parameters, and exit.
     #[arg(long)]
     pub accels: bool,
-    /// Lift the limits on image size, samples and recursion depth (as `arbor render --no-limits`).
+    /// Lift the limits on image size, samples, recursion depth and the pixels of the images a scene reads
+    /// (as `arbor render --no-limits`).
     #[arg(long)]
     pub no_limits: bool,
 }
@@ -35,7 +36,8 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     }
     let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
     let desc = crate::render::read_scene(&args.scene)?;
-    arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
+    let limits = crate::render::limits(args.no_limits);
+    arbor::scene::check_limits(&desc, None, &limits)?;
     say!("scene      {}", crate::shown(&args.scene));
     say!(
         "settings   background {}  ambient {}  max depth {}  shadow epsilon {}  back-face culling {}",
@@ -125,7 +127,7 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         say!("warning    {w}");
     }
     let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
-    let scene = Scene::build(desc, &spec, None)?;
+    let scene = Scene::build_within(desc, &spec, None, &limits.images)?;
     let cameras: Vec<usize> = (0..scene.cameras.len()).collect();
     for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, None) {
         say!("warning    {w}");

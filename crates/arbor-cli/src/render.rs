@@ -106,7 +106,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_warnings: bool,
     /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
-    /// depth (64) and pixels x samples (2^34) that guard against crafted scene files.
+    /// depth (64), pixels x samples (2^34) and the pixels of each image the scene reads (2^26: textures,
+    /// environment maps, cube faces, --env) that guard against crafted scene files.
     #[arg(long)]
     pub no_limits: bool,
 }
@@ -194,7 +195,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             cameras.len()
         )));
     }
-    check_limits(&desc, args.spp, &limits(args.no_limits))?;
+    let limits = limits(args.no_limits);
+    check_limits(&desc, args.spp, &limits)?;
     if let Some((_, _, x1, y1)) = args.crop {
         if let Some(cam) = cameras.iter().map(|&c| &desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
             return Err(arbor::Error::Invalid(format!(
@@ -222,9 +224,9 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         let cams: Vec<_> = cameras.iter().map(|&c| &desc.cameras[c]).collect();
         crate::memory::reserve_run(&cams, &targets, args.crop, args.debug.is_none())?;
     }
-    let env = args.env.as_deref().map(EnvMap::load).transpose()?;
+    let env = args.env.as_deref().map(|p| EnvMap::load(p, &limits.images)).transpose()?;
     let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
-    let scene = Scene::build(desc, &spec, env)?;
+    let scene = Scene::build_within(desc, &spec, env, &limits.images)?;
     let warn = args.quiet < 2 && !args.no_warnings;
     let whitted = args.debug.is_none_or(|v| v.shades())
         && cameras.iter().any(|&c| {

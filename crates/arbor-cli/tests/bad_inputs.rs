@@ -13,27 +13,34 @@
 //!
 //! The runs happen in the catalogue folder, so messages show paths relative to it, as a user sees them.
 //! To add a row, add the file and its expected message.
+//!
+//! Hostile images (decompression bombs, headers claiming huge images, NaN texels) are written by the test
+//! itself ([`hostile_images`]) and run the same way, each with an older image in its output folder that
+//! must come out unchanged.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+#[path = "hostile_images/mod.rs"]
+mod hostile_images;
 
 /// One run: the arguments after `arbor` (`OUT` at the start of one stands for the output folder), the exit
 /// code, stderr.
 struct Row {
     args: Vec<&'static str>,
     code: i32,
-    stderr: &'static str,
+    stderr: String,
 }
 
 /// `arbor render SCENE -o OUT`.
-fn render(scene: &'static str, code: i32, stderr: &'static str) -> Row {
-    Row { args: vec!["render", scene, "-o", "OUT"], code, stderr }
+fn render(scene: &'static str, code: i32, stderr: impl Into<String>) -> Row {
+    Row { args: vec!["render", scene, "-o", "OUT"], code, stderr: stderr.into() }
 }
 
 /// Any other command line.
-fn cmd(args: &[&'static str], code: i32, stderr: &'static str) -> Row {
-    Row { args: args.to_vec(), code, stderr }
+fn cmd(args: &[&'static str], code: i32, stderr: impl Into<String>) -> Row {
+    Row { args: args.to_vec(), code, stderr: stderr.into() }
 }
 
 #[rustfmt::skip]
@@ -252,7 +259,7 @@ fn catalogue() -> Vec<Row> {
     cmd(&["diff", "tex.png", "truncated.png"], 3, "error: truncated.png: cannot decode image: unexpected end of file (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.ppm"], 3, "error: truncated.ppm: cannot decode image: unexpected end of file (the file is truncated)\n"),
     cmd(&["diff", "tex.png", "truncated.jpg"], 3, "error: truncated.jpg: cannot decode image: the JPEG data ends before its end-of-image marker (the file is truncated)\n"),
-    cmd(&["diff", "tex.png", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: Format error decoding OpenExr: invalid: reference to missing bytes\n"),
+    cmd(&["diff", "tex.png", "truncated.exr"], 3, "error: truncated.exr: cannot decode image: not a readable OpenEXR file: invalid: reference to missing bytes\n"),
     cmd(&["diff", "tex.png", "no_such_image.png"], 4, "error: no_such_image.png: No such file or directory (os error 2)\n"),
     cmd(&["info", "huge_image.xml"], 3, "error: huge_image.xml:3:9: Camera 1: image 100000x100000 exceeds the limit of 16384x16384 pixels; --no-limits lifts the limits\n"),
     cmd(&["info", "huge_image.xml", "--no-limits"], 0, ""),
@@ -279,8 +286,10 @@ fn catalogue() -> Vec<Row> {
     ]
 }
 
-/// What went wrong with one row, if anything.
+/// What went wrong with one row, if anything: a run that fails must leave the files of `out` (a folder,
+/// missing or holding older images) as they were.
 fn run(row: &Row, dir: &Path, out: &Path) -> Result<(), String> {
+    let before = files(out);
     let args: Vec<String> = row
         .args
         .iter()
@@ -319,14 +328,25 @@ fn run(row: &Row, dir: &Path, out: &Path) -> Result<(), String> {
     let Some(code) = status.code() else {
         return Err(format!("killed by a signal (out of memory?): {status}; stderr: {stderr}"));
     };
-    if (code, stderr.as_str()) != (row.code, row.stderr) {
+    if (code, stderr.as_str()) != (row.code, row.stderr.as_str()) {
         return Err(format!("exit {code}, stderr:\n{stderr}expected exit {}, stderr:\n{}", row.code, row.stderr));
     }
-    let written = std::fs::read_dir(out).map_or(0, |d| d.count());
-    if row.args[0] == "render" && (code == 0) != (written > 0) {
-        return Err(format!("exit {code} but {written} files written"));
+    let after = files(out);
+    let written =
+        after.iter().filter(|f| !before.contains(f)).count() + before.iter().filter(|f| !after.contains(f)).count();
+    if matches!(row.args[0], "render" | "merge") && (code == 0) != (written > 0) {
+        return Err(format!("exit {code} but {written} files written, changed or removed"));
     }
     Ok(())
+}
+
+/// The files of the folder `dir` with their contents, sorted (none when it is missing).
+fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map(|d| d.map(|e| e.unwrap().path()).map(|p| (p.clone(), std::fs::read(&p).unwrap())).collect())
+        .unwrap_or_default();
+    files.sort();
+    files
 }
 
 /// Standard error without the plain progress lines a render prints when it is not a terminal
@@ -371,6 +391,29 @@ fn bad_inputs_give_located_errors_and_never_panic() {
         catalogue().len(),
         failures.join("\n\n")
     );
+}
+
+/// The hostile images of [`hostile_images`], written into a folder of their own, each run with an older
+/// image of the name it would write (`out.png`, `merged.png`) in its output folder.
+#[test]
+fn bad_inputs_hostile_images_are_refused_before_decoding_and_never_abort() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("images");
+    std::fs::create_dir(&dir).unwrap();
+    hostile_images::write_all(&dir, &catalogue_dir());
+    let mut failures = Vec::new();
+    let rows = hostile_images::rows();
+    for (i, row) in rows.iter().enumerate() {
+        let out = tmp.path().join(format!("run{i}"));
+        std::fs::create_dir(&out).unwrap();
+        for name in ["out.png", "merged.png"] {
+            std::fs::write(out.join(name), b"an older image").unwrap();
+        }
+        if let Err(e) = run(row, &dir, &out) {
+            failures.push(format!("arbor {}: {e}", row.args.join(" ")));
+        }
+    }
+    assert!(failures.is_empty(), "{} of {} rows failed:\n\n{}", failures.len(), rows.len(), failures.join("\n\n"));
 }
 
 /// Every scene of the catalogue has its row, and every mesh file and image is named by some scene

@@ -23,6 +23,7 @@ use super::runtime::{RayOffset, Scene};
 use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
+use crate::image_io::ImageLimits;
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
 use crate::material::{Brdf, BrdfModel, Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent, DEGAMMA};
@@ -37,14 +38,26 @@ impl Scene {
     /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
     /// both levels. `environment` overrides the scene's own map. A map the scene names
     /// (`SphericalDirectionalLight`) also lights it; one given only by `environment` is background only.
+    /// The images the scene reads are held to the default budget, [`ImageLimits::DEFAULT`].
     pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
+        Scene::build_within(desc, spec, environment, &ImageLimits::DEFAULT)
+    }
+
+    /// [`Scene::build`] with every image the scene reads (textures, its environment map or cube faces)
+    /// held to `images`.
+    pub fn build_within(
+        desc: SceneDesc,
+        spec: &AccelConfig,
+        environment: Option<EnvMap>,
+        images: &ImageLimits,
+    ) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
-            None => load_environment(&desc)?,
+            None => load_environment(&desc, images)?,
         };
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
-        let textures = textures::build_textures(&desc)?;
+        let textures = textures::build_textures(&desc, images)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
         // The radius of the bounded objects' bounding sphere, for the power of lights at infinity.
         let bounds = geometry.top.bounds();
@@ -54,7 +67,8 @@ impl Scene {
         if let (Some(map), true) = (&environment, desc.environment.is_some()) {
             let units = 1.0 / desc.radiance_scale;
             environment_light = Some(lights.len());
-            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units).with_scene_radius(radius)));
+            let light = SphericalDirectionalLight::new(map.clone(), units).map_err(|e| environment_error(&desc, e))?;
+            lights.push(Box::new(light.with_scene_radius(radius)));
         }
         let (object_lights, object_emission) = emitters::build_emitters(&desc, &geometry, &mut lights)?;
         let offset = match desc.offset {
@@ -97,22 +111,28 @@ impl Scene {
     }
 }
 
-/// The environment map the scene names, if any. A map that cannot be read is the scene's fault, like a
-/// missing mesh: located where the file names it.
-fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
+/// The environment map the scene names, if any, its images held to `images`. A map that cannot be read
+/// (or is above the budget, or does not fit in memory) is the scene's fault, like a missing mesh:
+/// located where the file names it.
+fn load_environment(desc: &SceneDesc, images: &ImageLimits) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
-    let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
-    map.map(Some).map_err(|e| {
-        let why = match e {
-            Error::Io { source, .. } => source.to_string(),
-            // An undecodable map file; a face of a cube-map folder keeps its own name in the message.
-            Error::Input { loc, msg } if loc.file == path => msg,
-            e @ Error::Input { .. } => e.to_string(),
-            other => return other,
-        };
-        let loc = desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source));
-        Error::input(loc, format!("cannot read environment map '{}': {why}", path.display()))
-    })
+    let map = if desc.environment_probe { EnvMap::load_probe(path, images) } else { EnvMap::load(path, images) };
+    map.map(Some).map_err(|e| environment_error(desc, e))
+}
+
+/// An error of the scene's environment map `desc.environment`, at the element that names it.
+fn environment_error(desc: &SceneDesc, e: Error) -> Error {
+    let Some(path) = desc.environment.as_deref() else { return e };
+    let why = match e {
+        Error::Io { source, .. } => source.to_string(),
+        // An undecodable map file; a face of a cube-map folder keeps its own name in the message.
+        Error::Input { loc, msg } if loc.file == path => msg,
+        e @ Error::Input { .. } => e.to_string(),
+        Error::OutOfMemory(msg) => msg,
+        other => return other,
+    };
+    let loc = desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source));
+    Error::input(loc, format!("cannot read environment map '{}': {why}", path.display()))
 }
 
 /// The runtime camera of a description: its transform applied to position, gaze and up.
