@@ -5,6 +5,10 @@
 #
 # Assumes the PersistentVolumeClaim `arbor-work` (ReadWriteMany) holds the scene under /work/scenes.
 set -euo pipefail
+if ! command -v kubectl >/dev/null 2>&1; then
+    echo "$0: kubectl not found on PATH; nothing was submitted" >&2
+    exit 127
+fi
 here="$(cd "$(dirname "$0")" && pwd)"
 timeout="${1:-1h}"
 kubectl delete job arbor-tiles arbor-merge --ignore-not-found

@@ -6,12 +6,23 @@
 #
 # Environment: ARBOR (the arbor binary, default: `arbor` on PATH), PARTS (folder for the partial EXRs,
 # default: OUTPUT's folder/parts), SBATCH_FLAGS (extra sbatch flags for both jobs, e.g. "-p gpu -t 1:00:00").
-# Paths are made absolute, so the jobs may start in any folder of a shared file system.
+# Paths are made absolute, so the jobs may start in any folder of a shared file system. Nothing is
+# created (no folder, no job) unless every command it needs is there and the arguments make sense.
 set -euo pipefail
 if [ $# -lt 3 ]; then
     echo "usage: $0 SCENE TILES OUTPUT [ARBOR RENDER FLAGS...]" >&2
     exit 2
 fi
+for tool in sbatch realpath dirname mkdir; do
+    if ! command -v "$tool" >/dev/null 2>&1; then
+        hint=""
+        if [ "$tool" = sbatch ]; then
+            hint=" (Slurm's job submission; run this on a Slurm login node, or see docs/farm.md for tiles without Slurm)"
+        fi
+        echo "$0: $tool not found on PATH$hint; nothing was created" >&2
+        exit 127
+    fi
+done
 here="$(cd "$(dirname "$0")" && pwd)"
 SCENE="$(realpath "$1")"
 TILES="$2"

@@ -7,6 +7,8 @@ use std::path::Path;
 
 use arbor::accel::AccelConfig;
 use arbor::geometry::TriangleMesh;
+use arbor::image_io::ImageLimits;
+use arbor::math::Color;
 use arbor::scene::{build_geometry, MeshSource, SceneDesc, ShapeDesc};
 
 /// What `arbor::mesh_io` promises of a mesh it returns: every index in range, every coordinate finite,
@@ -61,5 +63,33 @@ fn check_desc(desc: &SceneDesc) {
             }
         }
         assert!(o.material < desc.materials.len(), "{}: material {} of {}", o.name, o.material, desc.materials.len());
+    }
+}
+
+/// The pixel budget of the image targets: the same checks as the default budget (2^26), with every
+/// buffer at most a few tens of MB, well inside libFuzzer's 1 GiB.
+pub const IMAGE_LIMITS: ImageLimits = ImageLimits { max_pixels: 1 << 20 };
+
+/// Decodes `data` as the image file `name` (whose extension is the format when the bytes do not tell)
+/// into colours and into 8-bit RGB through `arbor::image_io::decode`, within [`IMAGE_LIMITS`]: both
+/// succeed or both fail, and an image has the size the budget allows and the texels its size says.
+pub fn decode_image(data: &[u8], name: &str) {
+    let path = Path::new(name);
+    let colours = arbor::image_io::decode::<Color>(data, path, &IMAGE_LIMITS);
+    let bytes = arbor::image_io::decode::<u8>(data, path, &IMAGE_LIMITS);
+    match (colours, bytes) {
+        (Ok((w, h, colours)), Ok((w8, h8, bytes))) => {
+            assert_eq!((w, h), (w8, h8), "{name}: two sizes");
+            let n = w as u64 * h as u64;
+            assert!(
+                n <= IMAGE_LIMITS.max_pixels,
+                "{name}: {w}x{h} read within a budget of {}",
+                IMAGE_LIMITS.max_pixels
+            );
+            assert_eq!(colours.len() as u64, n, "{name}: {} colours for {w}x{h}", colours.len());
+            assert_eq!(bytes.len() as u64, 3 * n, "{name}: {} bytes for {w}x{h}", bytes.len());
+        }
+        (Err(_), Err(_)) => {}
+        (a, b) => panic!("{name}: colours {:?} but 8-bit {:?}", a.map(|_| ()), b.map(|_| ())),
     }
 }

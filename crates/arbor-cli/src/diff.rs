@@ -10,7 +10,7 @@ use arbor::film::Film;
 use arbor::image_io::levels::{BlockLevels, DisplayCurve};
 use arbor::image_io::metrics::{compare_block_levels, compare_blocks_rgb8, compare_rgb8, BlockComparison, Comparison};
 use arbor::image_io::noisy::{compare_noisy, compare_noisy_rgb8};
-use arbor::image_io::{is_hdr_path, read_image, read_rgb8};
+use arbor::image_io::{is_hdr_path, read, read_image_within, ImageLimits};
 use clap::Args;
 
 use crate::Failure;
@@ -44,6 +44,9 @@ pub struct DiffArgs {
     /// difference within 2 levels. --threshold and --max-off do not apply.
     #[arg(long, value_name = "IMAGE_OTHER_SEED")]
     pub noise: Option<PathBuf>,
+    /// Lift the limit on the pixels of each image (2^28, the most `arbor render` writes by default).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Parses `--max-off`: a percentage from 0 to 100 (a NaN limit would pass every image).
@@ -70,11 +73,39 @@ enum Images {
     Hdr { reference: Film, images: Vec<Film> },
 }
 
-/// Reads the reference and `images`, all 8-bit or all HDR, all of one size.
-fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
-    let hdr = is_hdr_path(reference);
-    for path in images {
-        if is_hdr_path(path) != hdr {
+/// One image as read: 8-bit levels, or radiance for an HDR file.
+enum Read {
+    Rgb8(u32, u32, Vec<u8>),
+    Hdr(Film),
+}
+
+impl Read {
+    fn of(path: &Path, limits: &ImageLimits) -> Result<Read, Failure> {
+        Ok(if is_hdr_path(path) {
+            Read::Hdr(read_image_within(path, limits)?)
+        } else {
+            let (w, h, px) = read::<u8>(path, limits)?;
+            Read::Rgb8(w, h, px)
+        })
+    }
+
+    fn size(&self) -> (u32, u32) {
+        match self {
+            Read::Rgb8(w, h, _) => (*w, *h),
+            Read::Hdr(f) => (f.width, f.height),
+        }
+    }
+}
+
+/// Reads the reference and `images` (each fails as a file first), then checks that they are all 8-bit or
+/// all HDR, and all of one size.
+fn read_all(reference: &Path, images: &[&PathBuf], limits: &ImageLimits) -> Result<Images, Failure> {
+    let first = Read::of(reference, limits)?;
+    let rest = images.iter().map(|p| Read::of(p, limits)).collect::<Result<Vec<_>, _>>()?;
+    let want = first.size();
+    for (path, read) in images.iter().zip(&rest) {
+        let (hdr, other) = (matches!(first, Read::Hdr(_)), matches!(read, Read::Hdr(_)));
+        if hdr != other {
             let (what, other) = if hdr { ("an HDR", "an 8-bit") } else { ("an 8-bit", "an HDR") };
             return Err(Failure::Usage(format!(
                 "{} is {other} image but the reference {} is {what} one: compare radiance with radiance \
@@ -83,32 +114,27 @@ fn read_all(reference: &Path, images: &[&PathBuf]) -> Result<Images, Failure> {
                 reference.display()
             )));
         }
-    }
-    let size_check = |path: &Path, got: (u32, u32), want: (u32, u32)| {
-        if got == want {
-            return Ok(());
+        let got = read.size();
+        if got != want {
+            let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
+            return Err(arbor::Error::Invalid(msg).into());
         }
-        let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
-        Err(Failure::from(arbor::Error::Invalid(msg)))
-    };
-    if hdr {
-        let reference = read_image(reference)?;
-        let mut films = Vec::new();
-        for path in images {
-            let film = read_image(path)?;
-            size_check(path, (film.width, film.height), (reference.width, reference.height))?;
-            films.push(film);
-        }
-        return Ok(Images::Hdr { reference, images: films });
     }
-    let (width, height, reference) = read_rgb8(reference)?;
-    let mut rgbs = Vec::new();
-    for path in images {
-        let (w, h, px) = read_rgb8(path)?;
-        size_check(path, (w, h), (width, height))?;
-        rgbs.push(px);
-    }
-    Ok(Images::Rgb8 { width, height, reference, images: rgbs })
+    Ok(match first {
+        Read::Hdr(reference) => Images::Hdr {
+            reference,
+            images: rest.into_iter().filter_map(|r| if let Read::Hdr(f) = r { Some(f) } else { None }).collect(),
+        },
+        Read::Rgb8(width, height, reference) => Images::Rgb8 {
+            width,
+            height,
+            reference,
+            images: rest
+                .into_iter()
+                .filter_map(|r| if let Read::Rgb8(_, _, px) = r { Some(px) } else { None })
+                .collect(),
+        },
+    })
 }
 
 impl Images {
@@ -157,7 +183,8 @@ impl Images {
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
     let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
-    let images = read_all(&args.reference, &paths)?;
+    let limits = crate::render::limits(args.no_limits).rendered();
+    let images = read_all(&args.reference, &paths, &limits)?;
     if matches!(images, Images::Hdr { .. }) {
         say!(
             "HDR images: compared in 8-bit levels under the reference's curve (key 0.18 of its log-average, gamma 2.2)"

@@ -23,7 +23,8 @@ pub struct InfoArgs {
     /// List the acceleration structures and their parameters, and exit.
     #[arg(long)]
     pub accels: bool,
-    /// Lift the limits on image size, samples and recursion depth (as `arbor render --no-limits`).
+    /// Lift the limits on image size, samples, recursion depth and the pixels of the images a scene reads
+    /// (as `arbor render --no-limits`).
     #[arg(long)]
     pub no_limits: bool,
 }
@@ -57,14 +58,20 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
     }
     let spec = crate::render::accel_spec(args.accel, &args.accel_params)?;
     let desc = crate::render::read_scene(&args.scene)?;
-    arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
+    let limits = crate::render::limits(args.no_limits);
+    arbor::scene::check_limits(&desc, None, &limits)?;
     say!("scene      {}", crate::shown(&args.scene));
     say!(
-        "settings   background {}  ambient {}  max depth {}  shadow epsilon {}",
+        "settings   background {}  ambient {}  max depth {}  shadow epsilon {}  back-face culling {}",
         desc.background,
         desc.ambient,
         desc.max_depth,
-        desc.shadow_epsilon
+        desc.shadow_epsilon,
+        match desc.cull_backfaces {
+            Some(true) => "on",
+            Some(false) => "off",
+            None => "off (unless render --cull)",
+        }
     );
     for c in &desc.cameras {
         say!(
@@ -140,10 +147,16 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
         };
         say!("object     {}: {what}", o.name);
     }
-    for w in crate::warnings::scene_warnings(&desc) {
+    let dark = desc.cameras.iter().filter_map(|c| crate::warnings::dark_path_tracing(&desc, c, c.renderer, false));
+    for w in crate::warnings::scene_warnings(&desc).into_iter().chain(dark) {
         say!("warning    {w}");
     }
-    let scene = Scene::build(desc, &spec, None)?;
+    let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
+    let scene = Scene::build_within(desc, &spec, None, &limits.images)?;
+    let cameras: Vec<usize> = (0..scene.cameras.len()).collect();
+    for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, None) {
+        say!("warning    {w}");
+    }
     let g = &scene.geometry.counts;
     say!(
         "geometry   {} triangles ({} degenerate), {} spheres, {} planes; bounds {} .. {}; meshes read in {:.1} ms",

@@ -1,5 +1,5 @@
 //! `arbor`: render scene files (whole or in farm slices), merge slices, describe scenes, benchmark their
-//! acceleration structures, compare images.
+//! acceleration structures, compare images, show a scene live in a web page.
 //!
 //! Exit codes: 0 success, 1 `diff` found the images too different, 2 usage error, 3 bad input,
 //! 4 I/O failure or not enough memory, 130 and 143 when stopped by SIGINT or SIGTERM (at any stage;
@@ -23,6 +23,7 @@ mod render;
 mod signals;
 mod slice;
 mod threads;
+mod view;
 mod warnings;
 
 use std::path::PathBuf;
@@ -53,6 +54,10 @@ enum Command {
     /// Compare an image with a reference: PSNR, bias and the share of pixels (or, for noisy renders, of
     /// KxK-pixel block means) off by more than a threshold.
     Diff(diff::DiffArgs),
+    /// Show a scene live in a web page: the render (orbit, pan, zoom), the structure's boxes and cost
+    /// heatmap, a pixel's rays, two structures side by side and a benchmark chart. Prints the address
+    /// to open (with its token) and serves until Ctrl-C.
+    View(view::ViewArgs),
 }
 
 /// How a command ended, when not in success.
@@ -63,6 +68,9 @@ pub enum Failure {
     Usage(String),
     /// An error from the library (exit 3 for bad input, 4 for I/O).
     Arbor(arbor::Error),
+    /// An error about a file, after where the scene names it (`s.xml:9:13: Camera 1: ImageName 'x.png'`):
+    /// exit 3 or 4, as the error's.
+    At(String, arbor::Error),
     /// Stopped by a signal: 130 for SIGINT, 143 for SIGTERM (128 + the signal number, as shells report).
     Interrupted(u8),
     /// A buffer could not be allocated (exit 4, like other failures of the machine rather than the input).
@@ -96,7 +104,7 @@ fn main() -> ExitCode {
     let stopped = match cli.command {
         Command::Render(_) => signals::RENDER_STOPPED,
         Command::Merge(_) => signals::MERGE_STOPPED,
-        Command::Info(_) | Command::Bench(_) | Command::Diff(_) => signals::STOPPED,
+        Command::Info(_) | Command::Bench(_) | Command::Diff(_) | Command::View(_) => signals::STOPPED,
     };
     let signals = match signals::Signals::install(stopped) {
         Ok(s) => s,
@@ -108,6 +116,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Merge(args) => merge::run(args, &signals),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -135,6 +144,10 @@ fn report(failure: Failure) -> ExitCode {
         }
         Failure::Arbor(e) => {
             eprintln!("error: {e}");
+            ExitCode::from(if e.is_io() { 4 } else { 3 })
+        }
+        Failure::At(at, e) => {
+            eprintln!("error: {at}: {e}");
             ExitCode::from(if e.is_io() { 4 } else { 3 })
         }
     }

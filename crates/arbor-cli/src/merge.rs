@@ -22,6 +22,10 @@ pub struct MergeArgs {
     /// No summary line (`Saved: IMAGE` stays).
     #[arg(short, long)]
     pub quiet: bool,
+    /// Lift the limit on the pixels of the frame and of each part (2^28, the most `arbor render` writes
+    /// by default).
+    #[arg(long)]
+    pub no_limits: bool,
 }
 
 /// Runs `arbor merge`.
@@ -42,10 +46,11 @@ pub fn run(args: MergeArgs, signals: &crate::signals::Signals) -> Result<(), Fai
             )));
         }
     }
+    let limits = crate::render::limits(args.no_limits).rendered();
     let parts = args
         .parts
         .iter()
-        .map(|p| arbor::farm::read_partial(p).map(|part| (p.clone(), part)))
+        .map(|p| arbor::farm::read_partial(p, &limits).map(|part| (p.clone(), part)))
         .collect::<Result<Vec<_>, _>>()?;
     let film = arbor::farm::merge(&parts)?;
     // Written as the single-process render writes it: the camera's tone mapping, the PNG beside HDR.

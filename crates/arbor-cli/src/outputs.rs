@@ -4,10 +4,13 @@
 //! `-o` names a folder (created if missing) into which every camera's image goes under the name the
 //! scene gives it, or, when it ends in an image extension, the one image of a scene with one camera (a
 //! scene with several is a usage error: `-o` then names a folder). Every target, and the PNG beside an
-//! HDR one, is checked: an extension Arbor writes, a folder that exists (images and partial EXRs may
-//! also name one that can be created, as their writers create it; `--stats-json` may not) and that
-//! accepts a new file (a probe file is created and removed at once, which also answers for root, for
-//! whom permission bits say nothing), and a name that is not a folder. Errors name the target file.
+//! HDR one, is checked: an extension Arbor writes, names and a path within the file system's limits
+//! (`NAME_MAX` and `PATH_MAX` as `pathconf` reports them for the nearest existing folder), a folder that
+//! exists (images and partial EXRs may also name one that can be created, as their writers create it;
+//! `--stats-json` may not) and that accepts a new file (a probe file is created and removed at once,
+//! which also answers for root, for whom permission bits say nothing), and a name that is not a folder.
+//! A camera's image is refused at its `ImageName` (a name the file system cannot hold is the scene's
+//! fault: exit 3; a folder that takes no file, the machine's: exit 4); other errors name the target file.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -52,10 +55,14 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc], with_preview: bool) ->
     // Every file written so far and its camera: the image, and the PNG beside an HDR image.
     let mut written: Vec<(PathBuf, &str)> = Vec::new();
     for cam in cameras {
+        let at = format!("{}: Camera {}: ImageName '{}'", cam.name_loc, cam.id, shortened(&cam.image_name));
         let refuse = |msg: String| {
-            let msg = format!("Camera {}: ImageName '{}': {msg}", cam.id, cam.image_name);
-            arbor::Error::input(cam.loc.clone(), msg)
+            let msg = format!("Camera {}: ImageName '{}': {msg}", cam.id, shortened(&cam.image_name));
+            arbor::Error::input(cam.name_loc.clone(), msg)
         };
+        if cam.image_name.contains('\0') {
+            return Err(refuse("contains a NUL character, which no file name may hold".into()).into());
+        }
         // A scene names its images inside the output folder: it may not write elsewhere.
         if !Path::new(&cam.image_name).components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)) {
             return Err(refuse("must be a name inside the output folder (no absolute path, no '..')".into()).into());
@@ -64,13 +71,17 @@ pub fn image_targets(out: &Path, cameras: &[&CameraDesc], with_preview: bool) ->
         check_extension(&path).map_err(refuse)?;
         let files = files_written(&path, with_preview);
         for file in &files {
+            check_lengths(file).map_err(refuse)?;
             if let Some((_, other)) = written.iter().find(|(f, _)| f == file) {
                 let msg = format!("{} would also be written by camera {other}", file.display());
                 return Err(refuse(msg).into());
             }
         }
         for file in &files {
-            check_writable(file, true)?;
+            check_writable(file, true).map_err(|f| match f {
+                Failure::Arbor(e) => Failure::At(at.clone(), e),
+                other => other,
+            })?;
         }
         written.extend(files.into_iter().map(|f| (f, cam.id.as_str())));
         targets.push(path);
@@ -90,23 +101,19 @@ pub fn check_extension(path: &Path) -> Result<(), String> {
 /// Checks that a new file can be created beside `path`. With `create`, missing folders are allowed when
 /// the nearest existing one accepts files (the write creates them); without, the folder must exist.
 pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
-    let fail = |why: String| Failure::Arbor(arbor::Error::io(path, std::io::Error::other(why)));
+    let fail = |why: String| {
+        let shown = PathBuf::from(shortened(&path.to_string_lossy()));
+        Failure::Arbor(arbor::Error::io(shown, std::io::Error::other(why)))
+    };
+    check_lengths(path).map_err(|why| fail(format!("cannot write it: {why}")))?;
     if path.is_dir() {
         return Err(fail("cannot write it: it is a folder".into()));
     }
-    let mut dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = folder_of(path);
     if !create && !dir.is_dir() {
         return Err(fail(format!("cannot write it: the folder {} does not exist", dir.display())));
     }
-    while !dir.exists() {
-        match dir.parent() {
-            Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
-            _ => dir = PathBuf::from("."),
-        }
-    }
+    let dir = nearest_existing(&dir);
     if !dir.is_dir() {
         return Err(fail(format!("cannot write it: {} is not a folder", dir.display())));
     }
@@ -119,6 +126,72 @@ pub fn check_writable(path: &Path, create: bool) -> Result<(), Failure> {
         }
         Err(e) => Err(fail(format!("cannot write it: {e}"))),
     }
+}
+
+/// The folder `path` is in (`.` for a bare name).
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// `dir`, or its nearest ancestor that exists (`.` at the end of a relative path).
+fn nearest_existing(dir: &Path) -> PathBuf {
+    let mut dir = dir.to_path_buf();
+    while !dir.exists() {
+        dir = folder_of(&dir);
+        if dir == Path::new(".") {
+            break;
+        }
+    }
+    dir
+}
+
+/// Checks that every name in `path` and the path itself fit the file system's limits, `NAME_MAX` and
+/// `PATH_MAX` (counting its final NUL), as the system reports them for the nearest existing folder; the
+/// write would fail on them only after the render. The writer's temporary names fit whenever the
+/// target's does (`arbor::image_io` cuts the name they keep).
+fn check_lengths(path: &Path) -> Result<(), String> {
+    let dir = nearest_existing(&folder_of(path));
+    if let Some(max) = pathconf(&dir, libc::_PC_NAME_MAX) {
+        let longest = path.components().map(|c| c.as_os_str().len()).max().unwrap_or(0);
+        if longest > max {
+            return Err(format!(
+                "a file or folder name in it is {longest} bytes long, more than the {max} this file system takes \
+                 (NAME_MAX)"
+            ));
+        }
+    }
+    if let Some(max) = pathconf(&dir, libc::_PC_PATH_MAX) {
+        let n = path.as_os_str().len();
+        if n >= max {
+            return Err(format!("the path is {n} bytes long, more than the {} this system takes (PATH_MAX)", max - 1));
+        }
+    }
+    Ok(())
+}
+
+/// `pathconf(dir, name)`: a limit of the file system `dir` is on; `None` when it has none or says nothing.
+fn pathconf(dir: &Path, name: libc::c_int) -> Option<usize> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: `c` is a NUL-terminated string that lives across the call, which only reads it.
+    let v = unsafe { libc::pathconf(c.as_ptr(), name) };
+    usize::try_from(v).ok().filter(|&v| v > 0)
+}
+
+/// `s` for a message: control characters escaped (`\u{0}`), and when long only its start and end
+/// around an ellipsis, so that a message about a name of 150,000 characters stays one line.
+fn shortened(s: &str) -> String {
+    let shown = |part: &mut dyn Iterator<Item = char>| -> String {
+        part.map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
+    };
+    let n = s.chars().count();
+    if n <= 64 {
+        return shown(&mut s.chars());
+    }
+    format!("{}…{}", shown(&mut s.chars().take(40)), shown(&mut s.chars().skip(n - 16)))
 }
 
 /// The files that writing the image `path` makes: the image, and with `with_preview` beside a

@@ -1,19 +1,21 @@
 //! `arbor render`: every camera of a scene to the image file it names, with a progress bar on a terminal
-//! (plain lines otherwise), one summary line and one `Saved: PATH` line per image, and optionally the
-//! same numbers as JSON (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs
-//! instead ([`crate::slice`]).
+//! (plain lines otherwise), one summary line per image, and optionally the same numbers as JSON
+//! (`--stats-json`). Farm slices (`--tile`, sample ranges) write partial EXRs instead ([`crate::slice`]).
 //!
 //! Every output path is worked out and checked before the scene is built ([`crate::outputs`]), and the
-//! memory an image needs is reserved before it is rendered (exit 4 when there is not enough). SIGINT and
-//! SIGTERM stop the command at any stage ([`crate::signals`]): the image being rendered is not written
-//! (the previous file, if any, stays as it was; images are written whole, by rename), and the command
-//! exits 130 or 143.
+//! memory an image needs is reserved before it is rendered (exit 4 when there is not enough). The files
+//! of a run (each camera's image, the PNG beside an HDR one, the statistics) are encoded as their render
+//! ends and written together after the last one, all or none ([`arbor::image_io::write_files`]), then
+//! listed as `Saved: PATH` lines: a run that fails at its third camera leaves no image of its first two
+//! and every older file as it was. The price is memory: the encoded files wait (reserved up front,
+//! [`crate::memory::reserve_run`]). SIGINT and SIGTERM stop the command at any stage
+//! ([`crate::signals`]): nothing of the run is written, and the command exits 130 or 143.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use arbor::accel::{AccelConfig, AccelKind};
-use arbor::farm::{write_partial, Partial};
+use arbor::farm::{encode_partial, Partial};
 use arbor::integrator::DebugView;
 use arbor::light::environment::EnvMap;
 use arbor::render::{render, render_sums, RenderOptions, RenderStats};
@@ -40,8 +42,10 @@ pub struct RenderArgs {
     /// Folder for the images (created if missing); each camera's file name comes from the scene. A name
     /// ending in an image extension (.png, .ppm, .exr, .hdr, .jpg, .jpeg) is the image of a one-camera
     /// scene. An .exr or .hdr image holds radiance in the scene's units (255 is an 8-bit image's white in
-    /// METU files) and gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a file of that name; the two are written together or not at all. For a slice (--tile,
-    /// --sample-offset/--sample-count, or --crop with a .exr name): the partial EXR.
+    /// METU files) and gets its tone-mapped PNG beside it (x.exr: x.png), which replaces a file of that
+    /// name. Every file of the run is written after the last render, all together, or none when the run
+    /// fails. For a slice (--tile, --sample-offset/--sample-count, or --crop with a .exr name): the partial
+    /// EXR.
     #[arg(short = 'o', long = "out", default_value = ".")]
     pub out: PathBuf,
     /// Acceleration structure: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up.
@@ -65,14 +69,20 @@ pub struct RenderArgs {
     /// (px nx py ny pz nz).
     #[arg(long)]
     pub env: Option<PathBuf>,
-    /// Skip triangles facing away from camera rays (the course's back-face culling).
+    /// Cull back faces of camera rays: skip the triangles and planes they meet from behind (the course's
+    /// back-face culling). Without --cull or --no-cull the scene decides: its BackfaceCulling element,
+    /// else culling for the 2025 JSON form (its official images are culled) and none for XML and NYU
+    /// JSON files (an XML image most of whose camera rays meet back faces gets a warning naming
+    /// --cull: the XML form does not say its year, and some years' images are culled).
     #[arg(long, conflicts_with = "no_cull")]
     pub cull: bool,
-    /// Never cull back faces, even when the scene asks for it.
+    /// Never cull back faces, even when the scene or its form (2025 JSON) asks for it.
     #[arg(long)]
     pub no_cull: bool,
-    /// A debug view instead of the image: boxes[:DEPTH] (the structure's boxes at DEPTH, default 3, as
-    /// wireframe over the render), heatmap (nodes visited + primitives tested per pixel, false colour,
+    /// A debug view instead of the image: boxes[:DEPTH] (wireframe over the render of the nodes DEPTH
+    /// levels below the root of each structure: the top level's over the objects and each mesh's own;
+    /// 0 is the root's box, the default 3; the levels are those the render summary's and `arbor info`'s
+    /// depths count, a BVH's binary tree's, so DEPTH = its depth max shows the deepest leaves), heatmap (nodes visited + primitives tested per pixel, false colour,
     /// legend along the bottom, maximum printed), primid (a colour per primitive), normal.
     #[arg(long, value_name = "VIEW")]
     pub debug: Option<DebugView>,
@@ -96,7 +106,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_warnings: bool,
     /// Lift the limits on image size (16384 per side, 2^28 pixels), samples per pixel (65536), recursion
-    /// depth (64) and pixels x samples (2^34) that guard against crafted scene files.
+    /// depth (64), pixels x samples (2^34) and the pixels of each image the scene reads (2^26: textures,
+    /// environment maps, cube faces, --env) that guard against crafted scene files.
     #[arg(long)]
     pub no_limits: bool,
 }
@@ -170,6 +181,12 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         for w in crate::warnings::scene_warnings(&desc) {
             eprintln!("warning: {w}");
         }
+        for cam in cameras.iter().map(|&c| &desc.cameras[c]) {
+            let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?.unwrap_or(cam.renderer);
+            if let Some(w) = crate::warnings::dark_path_tracing(&desc, cam, renderer, args.env.is_some()) {
+                eprintln!("warning: {w}");
+            }
+        }
     }
     if slice.is_some() && cameras.len() != 1 {
         return Err(Failure::Usage(format!(
@@ -178,7 +195,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             cameras.len()
         )));
     }
-    check_limits(&desc, args.spp, &limits(args.no_limits))?;
+    let limits = limits(args.no_limits);
+    check_limits(&desc, args.spp, &limits)?;
     if let Some((_, _, x1, y1)) = args.crop {
         if let Some(cam) = cameras.iter().map(|&c| &desc.cameras[c]).find(|c| x1 > c.width || y1 > c.height) {
             return Err(arbor::Error::Invalid(format!(
@@ -202,8 +220,22 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     if let Some(file) = &args.stats_json {
         crate::outputs::check_writable(file, false)?;
     }
-    let env = args.env.as_deref().map(EnvMap::load).transpose()?;
-    let scene = Scene::build(desc, &spec, env)?;
+    if slice.is_none() {
+        let cams: Vec<_> = cameras.iter().map(|&c| &desc.cameras[c]).collect();
+        crate::memory::reserve_run(&cams, &targets, args.crop, args.debug.is_none())?;
+    }
+    let env = args.env.as_deref().map(|p| EnvMap::load(p, &limits.images)).transpose()?;
+    let camera_locs: Vec<_> = desc.cameras.iter().map(|c| c.loc.clone()).collect();
+    let scene = Scene::build_within(desc, &spec, env, &limits.images)?;
+    let warn = args.quiet < 2 && !args.no_warnings;
+    let whitted = args.debug.is_none_or(|v| v.shades())
+        && cameras.iter().any(|&c| {
+            let own = scene.cameras[c].renderer;
+            args.integrator.renderer(own).is_ok_and(|r| r.unwrap_or(own) == Renderer::Whitted)
+        });
+    if let Some(w) = crate::warnings::tree_warning(&crate::shown(&args.scene), &scene).filter(|_| warn && whitted) {
+        eprintln!("warning: {w}");
+    }
     signals.enter(Stage::Render);
     let cull = if args.cull {
         Some(true)
@@ -212,6 +244,11 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
     } else {
         None
     };
+    if args.quiet < 2 && !args.no_warnings {
+        for w in crate::warnings::back_faces(&scene, &cameras, &camera_locs, cull) {
+            eprintln!("warning: {w}");
+        }
+    }
     let base = RenderOptions {
         spp: args.spp,
         cull_backfaces: cull,
@@ -222,8 +259,12 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         seed: args.seed,
         renderer: None,
         sampler: args.integrator.sampler.into(),
+        heatmap_scale: None,
     };
     let mut records = Vec::new();
+    // Every file of the run, encoded, written together after the last render: all of them or none, so
+    // that a run that fails (an error, a signal, too little memory) leaves every older file as it was.
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     for (&c, target) in cameras.iter().zip(targets) {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
@@ -234,8 +275,6 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             }
         }
         let base = RenderOptions { renderer, ..base.clone() };
-        // The tone-mapped PNG beside a high-dynamic-range image.
-        let mut extra = Vec::new();
         // A debug view is written as it is.
         let tonemap = if args.debug.is_some() { None } else { cam.tonemap };
         let (path, stats, window) = match &slice {
@@ -253,9 +292,8 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 let (sums, stats) = render_sums(&scene, c, &opts, &|done, total| bar.set(done, total))?;
                 bar.finish();
                 signals.check()?;
-                signals.writing(|| {
-                    write_partial(&target, &Partial { identity: id, camera: cam.id.clone(), tonemap, sums })
-                })?;
+                let part = Partial { identity: id, camera: cam.id.clone(), tonemap, sums };
+                files.push((target.clone(), encode_partial(&target, &part)?));
                 (target, stats, window)
             }
             None => {
@@ -272,18 +310,18 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
                 } else {
                     (tonemap.or_else(|| hdr_preview(&target, scene.radiance_scale)), scene.radiance_scale)
                 };
-                let written =
-                    signals.writing(|| arbor::image_io::write_outputs(&target, &film, unit, tonemap.as_ref()))?;
-                extra = written.into_iter().filter(|p| *p != target).collect();
+                files.extend(arbor::image_io::encode_outputs(&target, &film, unit, tonemap.as_ref())?);
                 (target, stats, window)
             }
         };
         if args.quiet == 0 {
             summary(&args, &scene, &path, window, &stats, parse_time);
         }
-        say!("Saved: {}", path.display());
-        for p in &extra {
-            say!("Saved: {}", p.display());
+        if let Some(w) =
+            crate::warnings::capped_warning(&crate::shown(&args.scene), &cam.id, &stats, window_pixels(window))
+                .filter(|_| warn)
+        {
+            eprintln!("warning: {w}");
         }
         if let Some(max) = stats.heatmap_max {
             // Printed even with --quiet: without it the heatmap's colours have no scale.
@@ -309,12 +347,17 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             "triangles": scene.geometry.counts.triangles,
         }));
     }
+    let images = files.len();
     if let Some(file) = &args.stats_json {
         let text = serde_json::to_string_pretty(&json!({ "images": records }))
             .map_err(|e| arbor::Error::Invalid(format!("cannot encode the statistics: {e}")))?;
-        signals.writing(|| std::fs::write(file, text + "\n")).map_err(|e| arbor::Error::io(file, e))?;
+        files.push((file.clone(), (text + "\n").into_bytes()));
     }
-    // A signal during the last write let that (atomic) write finish; the run still reports it.
+    signals.writing(|| arbor::image_io::write_files(&files))?;
+    for (path, _) in &files[..images] {
+        say!("Saved: {}", path.display());
+    }
+    // A signal during the write let that (atomic) write finish; the run still reports it.
     signals.check()
 }
 
@@ -377,7 +420,7 @@ fn summary(
         stats.time.as_secs_f64() * 1e3,
         stats.rays as f64 / 1e6,
         stats.mrays_per_s(),
-        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of thread time", f * 100.0))
+        stats.traversal_share().map_or(String::new(), |f| format!("  traversal {:.0}% of CPU time", f * 100.0))
     );
     let s = scene.geometry.accel_stats();
     say!(
@@ -389,4 +432,9 @@ fn summary(
         s.mean_depth,
         args.debug.map_or(String::new(), |v| format!("; debug view {v}"))
     );
+}
+
+/// Pixels in a window `(x0, y0, x1, y1)`.
+fn window_pixels((x0, y0, x1, y1): (u32, u32, u32, u32)) -> u64 {
+    (x1 - x0) as u64 * (y1 - y0) as u64
 }

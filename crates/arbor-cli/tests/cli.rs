@@ -382,3 +382,105 @@ fn cli_info_describes_the_scene() {
         assert!(stdout(&o).contains(line), "{}", stdout(&o));
     }
 }
+
+#[test]
+fn cli_json_form_culls_by_default_and_no_cull_turns_it_off() {
+    // A wall filling the view with its back to the camera, lit by ambient light only (30 levels):
+    // culled, the image is the black background; unculled, the wall.
+    let files = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_inputs");
+    let tmp = tempfile::tempdir().unwrap();
+    let level = |scene: &str, flags: &[&str]| {
+        let out = tmp.path().join(format!("{scene}{}.png", flags.join("")));
+        let (scene, out_s) = (files.join(scene), out.to_str().unwrap().to_string());
+        let mut args = vec!["render", "-q", scene.to_str().unwrap(), "-o", &out_s];
+        args.extend(flags);
+        let o = arbor(&args, tmp.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (_, _, px) = arbor::image_io::read_rgb8(&out).unwrap();
+        assert!(px.iter().all(|&v| v == px[0]), "one colour");
+        px[0]
+    };
+    assert_eq!(level("back_faces.json", &[]), 0);
+    assert_eq!(level("back_faces.json", &["--no-cull"]), 30);
+    assert_eq!(level("back_faces.json", &["--cull"]), 0);
+    assert_eq!(level("back_faces.xml", &[]), 30);
+    assert_eq!(level("back_faces.xml", &["--cull"]), 0);
+    // `info` says which default applies, and gives the render's warning.
+    let info = |scene: &str| stdout(&arbor(&["info", files.join(scene).to_str().unwrap()], tmp.path()));
+    let json = info("back_faces.json");
+    assert!(json.contains("back-face culling on") && !json.contains("meet back faces"), "{json}");
+    let xml = info("back_faces.xml");
+    assert!(xml.contains("back-face culling off (unless render --cull)"), "{xml}");
+    assert!(
+        xml.contains(
+            "Camera 1: 100% of camera rays meet back faces; if the scene expects back-face culling, render with --cull"
+        ),
+        "{xml}"
+    );
+}
+
+/// A scene of eight inline meshes (bumpy grids of 2x60x60 triangles), built in parallel.
+fn eight_meshes() -> String {
+    let n = 60;
+    let mut vertices = String::new();
+    let mut meshes = String::new();
+    for k in 0..8 {
+        for j in 0..=n {
+            for i in 0..=n {
+                vertices += &format!("{i} {j} {}\n", k as f32 + ((i * 7 + j * 13) % 5) as f32 * 0.3);
+            }
+        }
+        let v = |i: u32, j: u32| k * (n + 1) * (n + 1) + j * (n + 1) + i + 1;
+        let faces: Vec<String> = (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                format!(
+                    "{} {} {} {} {} {}",
+                    v(i, j),
+                    v(i + 1, j),
+                    v(i + 1, j + 1),
+                    v(i, j),
+                    v(i + 1, j + 1),
+                    v(i, j + 1)
+                )
+            })
+            .collect();
+        meshes += &format!("<Mesh id=\"{}\"><Material>1</Material><Faces>{}</Faces></Mesh>\n", k + 1, faces.join(" "));
+    }
+    TINY.replace("IMAGE_EXT", "png")
+        .replace("<VertexData>0 0 0</VertexData>", &format!("<VertexData>{vertices}</VertexData>"))
+        .replace("<Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere>", &meshes)
+}
+
+#[test]
+fn cli_build_times_are_wall_times() {
+    // Not a speed check: the build time each command reports is no more than the wall time of the
+    // whole process (the meshes' structures, built in parallel, once counted their time per thread).
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = write(tmp.path(), "eight.xml", &eight_meshes());
+    let timed = |args: &[&str]| {
+        let start = std::time::Instant::now();
+        let o = arbor(args, tmp.path());
+        let elapsed_ms = start.elapsed().as_secs_f64() * 1e3;
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stdout(&o), elapsed_ms)
+    };
+    let number_after = |text: &str, key: &str| -> f64 {
+        let at = text.find(key).unwrap_or_else(|| panic!("no '{key}' in {text}")) + key.len();
+        text[at..].trim_start().split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
+    };
+    let scene = scene.to_str().unwrap();
+    for accel in ["kdtree", "bvh-sah"] {
+        let (out, ms) = timed(&["info", "--accel", accel, scene]);
+        let built = number_after(&out, "built in");
+        assert!(built > 0.0 && built <= ms, "info --accel {accel}: built in {built} ms, {ms} ms in all");
+        let (out, ms) = timed(&["render", "--accel", accel, scene, "--stats-json", "s.json", "-o", "out"]);
+        let build = number_after(&out, "build");
+        let json = std::fs::read_to_string(tmp.path().join("s.json")).unwrap();
+        let build_ms = number_after(&json, "\"build_ms\":");
+        assert!(build <= ms && build_ms <= ms, "render --accel {accel}: build {build} ms ({build_ms}), {ms} ms in all");
+        let (out, ms) = timed(&["bench", "--accel", accel, scene, "--size", "8x8", "--runs", "1", "--json"]);
+        let build_ms = number_after(&out, "\"build_ms\":");
+        assert!(build_ms <= ms, "bench --accel {accel}: build {build_ms} ms, {ms} ms in all");
+    }
+}

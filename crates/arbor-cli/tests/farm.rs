@@ -185,3 +185,52 @@ fn farm_cli_stats_json_and_plain_progress_lines() {
         assert!(!image[key].is_null(), "{key} missing");
     }
 }
+
+/// The first executable `name` on this process's PATH.
+fn on_path(name: &str) -> std::path::PathBuf {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| p.is_file()).unwrap_or_else(|| panic!("no {name}"))
+}
+
+#[test]
+fn farm_slurm_submit_without_sbatch_creates_nothing() {
+    // A PATH of only the tools submit.sh uses besides Slurm's: it ran `mkdir` and then failed on
+    // `sbatch: command not found`, leaving OUTPUT's folder and the parts folder behind.
+    let tmp = tempfile::tempdir().unwrap();
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    for tool in ["bash", "realpath", "dirname", "mkdir"] {
+        std::os::unix::fs::symlink(on_path(tool), bin.join(tool)).unwrap();
+    }
+    std::fs::write(tmp.path().join("scene.xml"), TWO_CAMERAS).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy/slurm/submit.sh");
+    let submit = || {
+        Command::new(bin.join("bash"))
+            .arg(&script)
+            .args(["scene.xml", "4", "renders/frame.png"])
+            .env_clear()
+            .env("PATH", &bin)
+            .current_dir(tmp.path())
+            .output()
+            .unwrap()
+    };
+    let o = submit();
+    let want = format!(
+        "{}: sbatch not found on PATH (Slurm's job submission; run this on a Slurm login node, or see docs/farm.md \
+         for tiles without Slurm); nothing was created\n",
+        script.display()
+    );
+    assert_eq!((o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned()), (Some(127), want));
+    let mut left: Vec<String> =
+        std::fs::read_dir(tmp.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert_eq!(left, ["bin", "scene.xml"]);
+
+    // With an sbatch (a stand-in that prints a job id), the folders are made and both jobs submitted.
+    std::fs::write(bin.join("sbatch"), "#!/bin/sh\necho 42\n").unwrap();
+    std::fs::set_permissions(bin.join("sbatch"), std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let o = submit();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(String::from_utf8_lossy(&o.stdout), "ARRAY_JOB=42\nMERGE_JOB=42\n");
+    assert!(tmp.path().join("renders/parts").is_dir());
+}

@@ -313,12 +313,13 @@ fn hardening_output_paths_are_checked_before_rendering() {
     let o = arbor(&["render", "tga.xml", "-o", "out"], tmp.path());
     let want = format!(
         "error: tga.xml:{}: Camera 1: ImageName 's.tga': cannot write .tga images; supported: png, ppm, exr, hdr, jpg, jpeg\n",
-        position(&text, "<Camera ")
+        position(&text, "<ImageName>")
     );
     assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
     assert!(o.stdout.is_empty(), "rendered before failing");
 
-    std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.png")).unwrap();
+    let text = scene(SPHERE, "s.png");
+    std::fs::write(tmp.path().join("s.xml"), &text).unwrap();
     let o = arbor(&["render", "s.xml", "-o", "out", "--stats-json", "nowhere/stats.json"], tmp.path());
     let want = "error: nowhere/stats.json: cannot write it: the folder nowhere does not exist\n";
     assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), want));
@@ -332,7 +333,11 @@ fn hardening_output_paths_are_checked_before_rendering() {
     std::fs::set_permissions(&locked, perms).unwrap();
     let folder = if std::fs::write(locked.join("probe"), b"").is_ok() { PathBuf::from("/sys") } else { locked };
     let o = arbor(&["render", "s.xml", "-o", folder.to_str().unwrap()], tmp.path());
-    let want = format!("error: {}: cannot write it: Permission denied (os error 13)\n", folder.join("s.png").display());
+    let want = format!(
+        "error: s.xml:{}: Camera 1: ImageName 's.png': {}: cannot write it: Permission denied (os error 13)\n",
+        position(&text, "<ImageName>"),
+        folder.join("s.png").display()
+    );
     assert_eq!((o.status.code(), stderr(&o)), (Some(4), want));
     assert_eq!(entries(tmp.path()), ["locked", "s.xml", "tga.xml"]);
 }
@@ -348,7 +353,7 @@ fn hardening_scene_images_stay_in_the_output_folder_and_apart() {
         let want = format!(
             "error: up.xml:{}: Camera 1: ImageName '{name}': must be a name inside the output folder (no absolute \
              path, no '..')\n",
-            position(&text, "<Camera ")
+            position(&text, "<ImageName>")
         );
         assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
         assert_eq!(entries(tmp.path()), ["up.xml"], "{name}: wrote something");
@@ -364,7 +369,7 @@ fn hardening_scene_images_stay_in_the_output_folder_and_apart() {
     let o = arbor(&["render", "two.xml", "-o", "out"], tmp.path());
     let want = format!(
         "error: two.xml:{}: Camera 2: ImageName 's.exr': out/s.png would also be written by camera 1\n",
-        position(&text, r#"<Camera id="2""#)
+        position(&text, "<ImageName>s.exr")
     );
     assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
 
@@ -379,7 +384,8 @@ fn hardening_scene_images_stay_in_the_output_folder_and_apart() {
 #[test]
 fn hardening_hdr_image_and_its_png_are_checked_together() {
     let tmp = tempfile::tempdir().unwrap();
-    std::fs::write(tmp.path().join("s.xml"), scene(SPHERE, "s.exr")).unwrap();
+    let text = scene(SPHERE, "s.exr");
+    std::fs::write(tmp.path().join("s.xml"), &text).unwrap();
     // The PNG beside the EXR cannot be written (a folder has its name): refused before rendering, and
     // the EXR is not written alone.
     std::fs::create_dir(tmp.path().join("x.png")).unwrap();
@@ -388,8 +394,9 @@ fn hardening_hdr_image_and_its_png_are_checked_together() {
     assert!(o.stdout.is_empty(), "rendered before failing");
     std::fs::create_dir_all(tmp.path().join("out/s.png")).unwrap();
     let o = arbor(&["render", "s.xml", "-o", "out"], tmp.path());
-    let want = "error: out/s.png: cannot write it: it is a folder\n";
-    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), want));
+    let at = position(&text, "<ImageName>");
+    let want = format!("error: s.xml:{at}: Camera 1: ImageName 's.exr': out/s.png: cannot write it: it is a folder\n");
+    assert_eq!((o.status.code(), stderr(&o)), (Some(4), want));
     assert_eq!(entries(tmp.path()), ["out", "s.xml", "x.png"]);
     assert_eq!(entries(&tmp.path().join("out")), ["s.png"]);
     // A debug view is written without a PNG beside it, so the folder is in nobody's way.
@@ -461,4 +468,83 @@ fn hardening_signal_stops_bench_and_info_too() {
         std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
         assert_eq!(err, "interrupted\n", "{args:?}");
     }
+}
+
+/// `scene(SPHERE, first)` with a second camera (id 2) writing `second` at `resolution`.
+fn two_cameras(first: &str, second: &str, resolution: &str) -> String {
+    let one = scene(SPHERE, first);
+    let end = one.find("</Camera>").map(|i| i + "</Camera>".len()).unwrap();
+    let camera = &one[one.find("<Camera ").unwrap()..end];
+    let camera2 = camera
+        .replace(r#"id="1""#, r#"id="2""#)
+        .replace(&format!(">{first}<"), &format!(">{second}<"))
+        .replace(">24 16<", &format!(">{resolution}<"));
+    format!("{}\n        {camera2}{}", &one[..end], &one[end..])
+}
+
+#[test]
+fn hardening_a_run_of_several_cameras_writes_all_its_images_or_none() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("first.png"), b"an older image").unwrap();
+    let unchanged = || {
+        assert_eq!(entries(&out), ["first.png"], "left behind");
+        assert_eq!(std::fs::read(out.join("first.png")).unwrap(), b"an older image", "clobbered");
+    };
+
+    // A second ImageName of 150,000 characters, which no file system holds: the first image was
+    // written (over the older one), then the write of the second failed naming neither scene nor line.
+    let long = format!("{}.png", "b".repeat(150_000));
+    let text = two_cameras("first.png", &long, "24 16");
+    std::fs::write(tmp.path().join("long.xml"), &text).unwrap();
+    let o = arbor(&["render", "long.xml", "-o", "out"], tmp.path());
+    let want = format!(
+        "error: long.xml:{}: Camera 2: ImageName '{}…{}.png': a file or folder name in it is 150004 bytes long, more \
+         than the 255 this file system takes (NAME_MAX)\n",
+        position(&text, &format!("<ImageName>{long}")),
+        "b".repeat(40),
+        "b".repeat(12)
+    );
+    assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
+    assert!(o.stdout.is_empty(), "rendered before failing");
+    unchanged();
+
+    // A NUL character (JSON can write one).
+    let json = r#"{"Scene": {"Cameras": {"Camera": {"_id": "1", "Position": "0 0 5", "Gaze": "0 0 -1", "Up": "0 1 0",
+            "NearPlane": "-1 1 -1 1", "NearDistance": "2", "ImageResolution": "8 8", "ImageName": "a\u0000b.png"}}}}"#;
+    std::fs::write(tmp.path().join("nul.json"), json).unwrap();
+    let o = arbor(&["render", "nul.json", "--no-warnings", "-o", "out"], tmp.path());
+    let want = format!(
+        "error: nul.json:{}: Camera 1: ImageName 'a\\u{{0}}b.png': contains a NUL character, which no file name may hold\n",
+        position(json, "\"ImageName\"")
+    );
+    assert_eq!((o.status.code(), stderr(&o)), (Some(3), want));
+    unchanged();
+
+    // A second image too large for the memory there is: refused before the first render.
+    let text = two_cameras("first.png", "second.png", "16000 16000");
+    std::fs::write(tmp.path().join("big.xml"), &text).unwrap();
+    let mut cmd = Command::new("sh");
+    cmd.arg("-c")
+        .arg("ulimit -v 1048576 && exec \"$0\" \"$@\"")
+        .arg(ARBOR)
+        .args(["render", "big.xml", "-o", "out"])
+        .current_dir(tmp.path());
+    let o = finish(cmd, Duration::from_secs(20));
+    let want = "error: not enough memory for a 16000x16000 image (23.8 GiB)\n";
+    assert_eq!((o.status.code(), stderr(&o).as_str()), (Some(4), want));
+    unchanged();
+
+    // A run that succeeds says what it wrote once everything is written.
+    let text = two_cameras("first.png", "second.exr", "20 10");
+    std::fs::write(tmp.path().join("two.xml"), &text).unwrap();
+    let o = arbor(&["render", "two.xml", "-o", "out"], tmp.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = String::from_utf8_lossy(&o.stdout);
+    let saved: Vec<&str> = said.lines().filter(|l| l.starts_with("Saved: ")).collect();
+    assert_eq!(saved, ["Saved: out/first.png", "Saved: out/second.exr", "Saved: out/second.png"]);
+    assert!(said.lines().rev().take(3).all(|l| l.starts_with("Saved: ")), "the Saved lines come last:\n{said}");
+    assert_eq!(entries(&out), ["first.png", "second.exr", "second.png"]);
+    assert_ne!(std::fs::read(out.join("first.png")).unwrap(), b"an older image");
 }

@@ -1,5 +1,6 @@
 //! No lost output: `arbor render` stopped by SIGINT or SIGTERM exits 130 or 143 and leaves the output
-//! folder as it was (no new image, no temporary file, an older image unchanged). Also `--crop`: the
+//! folder as it was (no new image, no temporary file, an older image unchanged), also when it stops at
+//! a later camera of a scene with several. Also `--crop`: the
 //! cropped image equals the same window of the full render.
 
 #![cfg(unix)]
@@ -125,4 +126,43 @@ fn crop_equals_the_window_of_the_full_render() {
     assert_eq!(bad.status.code(), Some(3), "{}", String::from_utf8_lossy(&bad.stderr));
     let empty = Command::new(ARBOR).args(["render", "--crop", "5,5,5,9"]).output().unwrap();
     assert_eq!(empty.status.code(), Some(2));
+}
+
+#[test]
+fn interrupt_during_the_second_camera_keeps_the_first_ones_older_image() {
+    // Camera 1 renders in a moment; camera 2 would take minutes. The signal comes once camera 1's
+    // summary is out, which the run printed only after writing camera 1's image over the older one.
+    let tmp = tempfile::tempdir().unwrap();
+    let example = include_str!("../../../examples/cornell_box.xml");
+    let (start, end) = (example.find("<Camera ").unwrap(), example.find("</Camera>").unwrap() + "</Camera>".len());
+    let camera = &example[start..end];
+    let first = camera.replace("cornell_box.png", "first.png");
+    let second = camera.replace("cornell_box.png", "second.png").replacen("id=\"", "id=\"2", 1);
+    let first = with_spp(&first, 1).replace(">400 400<", ">40 40<");
+    let second = with_spp(&second, 10_000);
+    let text = format!("{}{first}\n{second}{}", &example[..start], &example[end..]);
+    std::fs::write(tmp.path().join("two.xml"), text).unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("first.png"), b"an older image").unwrap();
+    let mut child = Command::new(ARBOR)
+        .args(["render", "two.xml", "--threads", "2", "-o", "out"])
+        .current_dir(tmp.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufRead::lines(std::io::BufReader::new(child.stdout.take().unwrap()));
+    let summary = lines.next().expect("camera 1's summary").unwrap();
+    assert!(summary.starts_with("out/first.png  "), "{summary}");
+    let code = signal_and_wait(child, "INT", Duration::ZERO);
+    assert_eq!(code, Some(130));
+    assert_eq!(entries(&out), ["first.png"]);
+    assert_eq!(std::fs::read(out.join("first.png")).unwrap(), b"an older image");
+}
+
+/// `camera` with `NumSamples` `spp` instead of its own.
+fn with_spp(camera: &str, spp: u32) -> String {
+    let (a, b) = (camera.find("<NumSamples>").unwrap(), camera.find("</NumSamples>").unwrap());
+    format!("{}<NumSamples>{spp}{}", &camera[..a], &camera[b..])
 }

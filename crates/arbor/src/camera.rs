@@ -163,6 +163,39 @@ impl Camera {
         }
     }
 
+    /// Where the camera is.
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The unit direction it looks in.
+    pub fn gaze(&self) -> Vec3 {
+        -self.w
+    }
+
+    /// Its unit up vector (at right angles to the gaze).
+    pub fn up(&self) -> Vec3 {
+        self.v
+    }
+
+    /// The same camera (window, lens, settings) moved to look from `eye` along `gaze` with `up`, making a
+    /// `width` x `height` image: a live view's camera, moved by the user, at a resolution of its own.
+    pub fn posed(&self, eye: Vec3, gaze: Vec3, up: Vec3, width: u32, height: u32) -> Camera {
+        // The camera's own pose keeps its basis to the bit (rebuilt, it could differ in the last bits),
+        // so that an unmoved view renders exactly as `arbor render` does.
+        if (eye, gaze, up) == (self.eye, self.gaze(), self.up()) {
+            return Camera { width, height, ..self.clone() };
+        }
+        Camera {
+            id: self.id.clone(),
+            image_name: self.image_name.clone(),
+            num_samples: self.num_samples,
+            tonemap: self.tonemap,
+            renderer: self.renderer,
+            ..Camera::new(eye, gaze, up, self.plane, self.projection, width, height)
+        }
+    }
+
     /// Continuous pixel coordinates of world point `p` (pixel `(x, y)` spans `[x, x+1) x [y, y+1)`), as
     /// the pinhole at the lens centre sees it; `None` when `p` is not in front of the camera.
     pub fn project(&self, p: Vec3) -> Option<DVec2> {

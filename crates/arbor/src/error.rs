@@ -91,5 +91,9 @@ impl Error {
     }
 }
 
+/// How a user lifts the resource limits (scenes, images): the end of every message that refuses
+/// something for exceeding one.
+pub const LIFT_LIMITS: &str = "--no-limits lifts the limits";
+
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -22,13 +22,7 @@ impl Film {
     /// A black film, or [`Error::OutOfMemory`] when its pixels cannot be allocated: a film large
     /// enough to fail is asked for before its render, not after.
     pub fn try_new(width: u32, height: u32) -> Result<Self> {
-        let n = width as usize * height as usize;
-        let mut pixels = Vec::new();
-        if pixels.try_reserve_exact(n).is_err() {
-            return Err(out_of_memory(width, height, n as u64 * std::mem::size_of::<Color>() as u64));
-        }
-        pixels.resize(n, Color::ZERO);
-        Ok(Film { width, height, pixels })
+        Ok(Film { width, height, pixels: try_filled(Color::ZERO, width, height)? })
     }
     /// The pixel at column `x`, row `y`.
     #[inline]
@@ -40,6 +34,18 @@ impl Film {
     pub fn to_rgb8(&self) -> Vec<u8> {
         self.pixels.iter().flat_map(|c| c.to_array()).map(quantize).collect()
     }
+}
+
+/// One `value` per pixel of a `width` x `height` image, or [`Error::OutOfMemory`] when they cannot be
+/// allocated.
+pub fn try_filled<T: Clone>(value: T, width: u32, height: u32) -> Result<Vec<T>> {
+    let n = width as usize * height as usize;
+    let mut v = Vec::new();
+    if v.try_reserve_exact(n).is_err() {
+        return Err(out_of_memory(width, height, n as u64 * std::mem::size_of::<T>() as u64));
+    }
+    v.resize(n, value);
+    Ok(v)
 }
 
 /// The error for buffers of `bytes` for a `width` x `height` image that could not be allocated.

@@ -31,6 +31,18 @@ pub fn load_bytes(path: &Path) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// An empty vector with room for `n` items of what is read from `path`, or, when they cannot be
+/// allocated, an out-of-memory I/O error naming the file, `what(gib)` saying what did not fit: the CLI's
+/// exit 4 (a scene's asset is located at its element instead) rather than an abort.
+pub(crate) fn vec_for<T>(n: u64, path: &Path, what: impl FnOnce(f64) -> String) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    if usize::try_from(n).ok().and_then(|n| v.try_reserve_exact(n).ok()).is_none() {
+        let gib = n as f64 * std::mem::size_of::<T>() as f64 / (1u64 << 30) as f64;
+        return Err(Error::io(path, std::io::Error::new(ErrorKind::OutOfMemory, what(gib))));
+    }
+    Ok(v)
+}
+
 /// Opens `path` for reading if it is a regular file.
 pub fn open_regular(path: &Path) -> Result<File> {
     let mut options = OpenOptions::new();

@@ -887,7 +887,7 @@ fn octree_faces(mesh: &TriangleMesh) -> (Aabb, [Vec<f32>; 3]) {
         arbor::accel::Octree::build(mesh, &arbor::accel::OctreeParams { max_leaf_prims: 1, ..Default::default() });
     let mut faces: [Vec<f32>; 3] = Default::default();
     for depth in 0..4 {
-        for b in arbor::accel::Accel::<TriangleMesh>::boxes_at_depth(&tree, depth) {
+        for b in arbor::accel::Accel::<TriangleMesh>::boxes_at_depth(&tree, mesh, depth) {
             for (a, f) in faces.iter_mut().enumerate() {
                 f.extend([b.min[a], b.max[a]]);
             }

@@ -70,6 +70,7 @@ fn scene(materials: Vec<MaterialDesc>, objects: Vec<ObjectDesc>, lights: Vec<Lig
         width: 1,
         height: 1,
         image_name: "x.exr".into(),
+        name_loc: Location::file("test"),
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,

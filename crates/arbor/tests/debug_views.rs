@@ -98,7 +98,9 @@ fn debug_primid_identical_across_structures_on_reference_scenes() {
                 let stride = (work / WORK_BUDGET).sqrt().ceil() as u32;
                 let cam = &desc.cameras[0];
                 let camera = arbor::scene::build_camera(cam);
-                let integrator = arbor::integrator::DebugIntegrator::new(&scene, DebugView::PrimId, false);
+                // Culled as `render` culls without an option: as the scene (or its form) says.
+                let cull = scene.cull_backfaces.unwrap_or(false);
+                let integrator = arbor::integrator::DebugIntegrator::new(&scene, DebugView::PrimId, cull);
                 let mut sampled = 0;
                 for y in (0..cam.height).step_by(stride as usize) {
                     for x in (0..cam.width).step_by(stride as usize) {
@@ -233,4 +235,26 @@ fn debug_boxes_view_draws_the_structure_over_the_render() {
     assert!(root.pixels.contains(&BOX_COLOR), "the root box is not drawn");
     let (none, _) = debug_render(&desc, AccelKind::BvhSah, DebugView::Boxes { depth: 60 });
     assert!(!none.pixels.contains(&BOX_COLOR), "boxes drawn below the deepest level");
+}
+
+#[test]
+fn debug_boxes_depth_is_the_depth_the_statistics_report() {
+    // `arbor info` and the render summary show `accel_stats().max_depth`: the deepest level the view
+    // draws, for every structure, in a scene of a mesh (its own structure) and a sphere (the top level
+    // then holds two objects).
+    let mesh = sphere_mesh(6000);
+    let mut desc = mesh_scene(mesh.clone(), Path::new("sphere"), framing_camera(mesh.bounds(), 64, 48));
+    let mut ball = desc.objects[0].clone();
+    ball.name = "ball".into();
+    ball.shape = ShapeDesc::Sphere { center: Vec3::new(3.0, 0.0, 0.0), radius: 0.5 };
+    desc.objects.push(ball);
+    for &kind in AccelKind::ALL {
+        let scene = Scene::build(desc.clone(), &AccelConfig::from(kind), None).unwrap();
+        let deepest = scene.geometry.accel_stats().max_depth;
+        assert!(deepest > 1 || kind == AccelKind::Brute, "{kind}: depth max {deepest} tests nothing");
+        for d in 0..=deepest {
+            assert!(!scene.geometry.boxes_at_depth(d).is_empty(), "{kind}: no box at depth {d} of {deepest}");
+        }
+        assert!(scene.geometry.boxes_at_depth(deepest + 1).is_empty(), "{kind}: boxes below depth max {deepest}");
+    }
 }

@@ -10,7 +10,7 @@ use arbor::film::Film;
 use arbor::render::{render, render_sums, RenderOptions};
 use arbor::renderer::{PathOptions, Renderer, Roulette};
 use arbor::sampler::SamplerKind;
-use arbor::scene::{parse_desc, Scene};
+use arbor::scene::{parse_desc, Scene, SceneLimits};
 use arbor::tonemap::Tonemap;
 
 fn example() -> Scene {
@@ -51,7 +51,7 @@ fn part_with(
     let tonemap = Some(Tonemap { key: 0.3, burn_percent: 2.5, saturation: 0.8, gamma: 1.8, ..Tonemap::PREVIEW });
     let p = Partial { identity: "example".into(), camera: cam.id.clone(), tonemap, sums };
     write_partial(&path, &p).unwrap();
-    let back = read_partial(&path).unwrap();
+    let back = read_partial(&path, &SceneLimits::default().rendered()).unwrap();
     assert_eq!(back, p, "{}", path.display());
     (path, back)
 }
@@ -178,7 +178,7 @@ fn farm_merge_refuses_parts_that_do_not_fit() {
     wide.sums.frame = (w - 1, h);
     let path = d.join("wide.exr");
     write_partial(&path, &wide).unwrap();
-    let e = read_partial(&path).unwrap_err().to_string();
+    let e = read_partial(&path, &SceneLimits::default().rendered()).unwrap_err().to_string();
     let msg = format!("the data window ({w} x {h} pixels at (0, 0)) is not inside the {} x {h} frame", w - 1);
     assert_eq!(e, format!("{}: {msg}", path.display()));
 }
@@ -188,6 +188,6 @@ fn farm_read_partial_refuses_a_plain_exr() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("plain.exr");
     arbor::image_io::write_image(&path, &Film::new(3, 2)).unwrap();
-    let e = read_partial(&path).unwrap_err().to_string();
+    let e = read_partial(&path, &SceneLimits::default().rendered()).unwrap_err().to_string();
     assert_eq!(e, format!("{}: not a partial image of `arbor render` (no arbor.render attribute)", path.display()));
 }

@@ -1,7 +1,7 @@
 //! Inputs found by the fuzz targets (`fuzz/`, see `docs/robustness.md`) that once made a reader or a
 //! structure panic or disagree, kept here with their bytes inline so `cargo test` replays them; and a
-//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files, so every run starts from inputs that
-//! reach past the first error.
+//! check that the fuzzers' seeds (`fuzz/seeds/`) are valid files (meshes, scenes, images), so every run
+//! starts from inputs that reach past the first error.
 
 use std::path::{Path, PathBuf};
 
@@ -62,6 +62,72 @@ fn fuzz_seeds_are_valid_scenes() {
             assert!(!d.objects.is_empty(), "seed {} has no object", f.display());
         }
     }
+}
+
+#[test]
+fn fuzz_seeds_are_valid_images() {
+    use arbor::image_io::{decode, ImageLimits};
+    // The budget of the targets (fuzz/fuzz_targets/common.rs).
+    let limits = ImageLimits { max_pixels: 1 << 20 };
+    for (target, name) in [
+        ("decode_png", "fuzz.png"),
+        ("decode_jpeg", "fuzz.jpg"),
+        ("decode_exr", "fuzz.exr"),
+        ("decode_hdr", "fuzz.hdr"),
+        ("decode_ppm", "fuzz.ppm"),
+    ] {
+        for f in seeds(target) {
+            let bytes = std::fs::read(&f).unwrap();
+            let (w, h, colours) = decode::<arbor::math::Color>(&bytes, Path::new(name), &limits)
+                .unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+            assert!(w > 0 && h > 0 && colours.len() == (w * h) as usize, "seed {}", f.display());
+        }
+    }
+    let partials: Vec<_> =
+        seeds("decode_exr").into_iter().filter(|f| f.to_string_lossy().contains("partial")).collect();
+    assert!(!partials.is_empty());
+    for f in partials {
+        let bytes = std::fs::read(&f).unwrap();
+        arbor::farm::decode_partial(&bytes, &f, &limits).unwrap_or_else(|e| panic!("seed {}: {e}", f.display()));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// decode_png, decode_exr
+
+/// Found by `decode_png` (fuzz/crashes/decode_png/crash-9705..., whose CRCs are corrected here: the png
+/// crate skips them when fuzzing): a 4x2 PNG of 2-bit palette indices whose `PLTE` chunk holds 13 bytes,
+/// four RGB entries and one byte. The png crate (0.18.1) accepts it and panics expanding the palette
+/// (`range end index 3 out of range for slice of length 1`, image-rs/image-png#694). Fixed: the chunks are
+/// walked first and such a palette is refused (`image_io/png.rs`).
+#[test]
+fn fuzz_png_palette_of_part_entries_is_refused_not_a_panic() {
+    #[rustfmt::skip]
+    const PNG: [u8; 75] = [
+    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 4, 0, 0, 0, 2, 2, 3, 0, 0, 0, 2, 198,
+    149, 240, 0, 0, 0, 13, 80, 76, 84, 69, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 155, 58, 33, 251, 173, 255,
+    255, 0, 12, 73, 68, 65, 84, 120, 156, 99, 145, 102, 124, 2, 0, 130,
+    ];
+    let e = arbor::image_io::decode::<u8>(&PNG, Path::new("p.png"), &arbor::image_io::ImageLimits::DEFAULT);
+    let msg = "p.png: cannot decode image: its palette (PLTE) holds 13 bytes, not whole RGB entries";
+    assert_eq!(e.unwrap_err().to_string(), msg);
+}
+
+/// Found by `decode_exr` (fuzz/crashes/decode_exr/crash-ca02...): a 3x2 EXR whose version flags say
+/// tiled (one level of 64x64 tiles) and whose block claims resolution level (0, 1). Read as a partial
+/// (`all_channels`), the exr crate let the block through its level filter and failed its own debug
+/// assertion `line should have been filtered` (without debug assertions it writes the block into level 0).
+/// Fixed: a header without `arbor.render` is refused before any block is read, and so is a tiled or deep
+/// one (a partial is flat scan lines; `partial_in_tiles_is_refused_before_its_blocks_are_read`). Read as
+/// an image it decodes, as the image crate's decoder reads it.
+#[test]
+fn fuzz_exr_tiled_header_is_no_partial() {
+    let bytes = include_bytes!("../../../fuzz/crashes/decode_exr/crash-ca023e370800ff53b40f9dd3a21e40e06479ebf9");
+    let limits = arbor::image_io::ImageLimits { max_pixels: 1 << 20 };
+    let e = arbor::farm::decode_partial(bytes, Path::new("t.exr"), &limits).unwrap_err().to_string();
+    assert_eq!(e, "t.exr: not a partial image of `arbor render` (no arbor.render attribute)");
+    let (w, h, _) = arbor::image_io::decode::<u8>(bytes, Path::new("t.exr"), &limits).unwrap();
+    assert_eq!((w, h), (3, 2));
 }
 
 // ---------------------------------------------------------------------------------------------------

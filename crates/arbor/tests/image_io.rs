@@ -5,7 +5,7 @@ use std::fs;
 use std::path::Path;
 
 use arbor::film::Film;
-use arbor::image_io::{compare_files, read_image, read_rgb8, write_image};
+use arbor::image_io::{compare_files, read_image, read_rgb8, write_image, ImageLimits};
 use arbor::math::Color;
 
 /// A film whose every channel is an exact 8-bit level, all levels distinct across the image.
@@ -210,7 +210,7 @@ fn compare_files_rgba_reference_equals_rgb_image() {
     let mut film = Film::new(2, 1);
     film.pixels = vec![Color::new(10.0, 20.0, 30.0) / 255.0, Color::new(40.0, 50.0, 60.0) / 255.0];
     write_image(&image, &film).unwrap();
-    let c = compare_files(&reference, &image, 0).unwrap();
+    let c = compare_files(&reference, &image, 0, &ImageLimits::DEFAULT).unwrap();
     assert!(c.identical() && c.psnr.is_infinite(), "{}", c.summary());
     assert_eq!((c.width, c.height, c.pixels_off), (2, 1, 0));
 }
@@ -222,7 +222,7 @@ fn compare_files_size_mismatch_error_text() {
     let image = dir.path().join("image.png");
     write_image(&reference, &Film::new(8, 8)).unwrap();
     write_image(&image, &Film::new(6, 4)).unwrap();
-    let err = compare_files(&reference, &image, 0).unwrap_err();
+    let err = compare_files(&reference, &image, 0, &ImageLimits::DEFAULT).unwrap_err();
     assert_eq!(err.to_string(), format!("{} is 6x4 but the reference {} is 8x8", image.display(), reference.display()));
 }
 
@@ -236,10 +236,10 @@ fn compare_files_counts_a_pixel_off_by_nine() {
     off.pixels[5].z = 109.0 / 255.0;
     write_image(&reference, &film).unwrap();
     write_image(&image, &off).unwrap();
-    let c = compare_files(&reference, &image, 8).unwrap();
+    let c = compare_files(&reference, &image, 8, &ImageLimits::DEFAULT).unwrap();
     assert_eq!((c.pixels_off, c.max_diff), (1, 9));
     assert_eq!(c.share_off, 1.0 / 16.0);
-    assert_eq!(compare_files(&reference, &image, 9).unwrap().pixels_off, 0);
+    assert_eq!(compare_files(&reference, &image, 9, &ImageLimits::DEFAULT).unwrap().pixels_off, 0);
 }
 
 fn solid(size: u32, c: Color) -> Film {
@@ -264,7 +264,7 @@ fn envmap_loads_cube_faces_by_any_naming_scheme() {
         write_image(&dir.path().join(name), &solid(4, c(v))).unwrap();
     }
     fs::write(dir.path().join("readme.txt"), b"not a face").unwrap();
-    let map = EnvMap::load(dir.path()).unwrap();
+    let map = EnvMap::load(dir.path(), &ImageLimits::DEFAULT).unwrap();
     assert!(map.is_cube_map());
     let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
     for (axis, (name, v)) in axes.iter().zip(files) {
@@ -287,7 +287,7 @@ fn envmap_cube_directory_lists_missing_and_duplicate_faces() {
     for name in ["px.png", "nx.png", "py.png", "nz.png"] {
         write_image(&dir.path().join(name), &solid(2, Color::ONE)).unwrap();
     }
-    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    let err = EnvMap::load(dir.path(), &ImageLimits::DEFAULT).unwrap_err().to_string();
     assert_eq!(
         err,
         format!("{}: cube map directory lacks faces -y (ny, negy, bottom); +z (pz, posz, front)", dir.path().display())
@@ -295,11 +295,11 @@ fn envmap_cube_directory_lists_missing_and_duplicate_faces() {
     write_image(&dir.path().join("ny.png"), &solid(2, Color::ONE)).unwrap();
     write_image(&dir.path().join("front.png"), &solid(2, Color::ONE)).unwrap();
     write_image(&dir.path().join("posz.exr"), &solid(2, Color::ONE)).unwrap();
-    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    let err = EnvMap::load(dir.path(), &ImageLimits::DEFAULT).unwrap_err().to_string();
     assert!(err.contains("two files for cube face +z"), "{err}");
     fs::remove_file(dir.path().join("posz.exr")).unwrap();
     write_image(&dir.path().join("ny.png"), &solid(3, Color::ONE)).unwrap();
-    let err = EnvMap::load(dir.path()).unwrap_err().to_string();
+    let err = EnvMap::load(dir.path(), &ImageLimits::DEFAULT).unwrap_err().to_string();
     assert!(err.contains("ny.png") && err.contains("is 3x3 but face +x is 2x2"), "{err}");
 }
 
@@ -316,11 +316,11 @@ fn envmap_loads_latlong_file_and_names_missing_one() {
         film.pixels[4 + x] = Color::splat(0.25);
     }
     write_image(&path, &film).unwrap();
-    let map = EnvMap::load(&path).unwrap();
+    let map = EnvMap::load(&path, &ImageLimits::DEFAULT).unwrap();
     assert!(!map.is_cube_map());
     assert_eq!(map.eval(Vec3::Y), Color::splat(5.0));
     assert_eq!(map.eval(-Vec3::Y), Color::splat(0.25));
-    let err = EnvMap::load(&dir.path().join("nope.hdr")).unwrap_err();
+    let err = EnvMap::load(&dir.path().join("nope.hdr"), &ImageLimits::DEFAULT).unwrap_err();
     assert!(err.to_string().contains("nope.hdr"), "{err}");
 }
 
@@ -452,4 +452,42 @@ fn write_outputs_hdr_pair_is_written_whole_or_not_at_all() {
     assert_eq!(read_image(&exr).unwrap(), film);
     assert_eq!(read_rgb8(&png).unwrap().2, Tonemap::PREVIEW.apply(&film).to_rgb8());
     assert_eq!(strays(dir.path(), &[]), ["out.exr", "out.png"]);
+}
+
+#[test]
+fn write_files_of_several_cameras_are_written_all_or_none() {
+    use arbor::image_io::{encode_outputs, write_files};
+    let dir = tempfile::tempdir().unwrap();
+    let film = level_film(2, 2);
+    let names = ["a.png", "b.ppm", "c.exr"];
+    let mut files = Vec::new();
+    for n in names {
+        files.extend(encode_outputs(&dir.path().join(n), &film, 1.0, None).unwrap());
+    }
+    fs::write(dir.path().join("a.png"), b"older a").unwrap();
+    fs::write(dir.path().join("b.ppm"), b"older b").unwrap();
+    // The last target is a folder: its rename fails after the first two were made, and they are undone.
+    fs::create_dir(dir.path().join("c.exr")).unwrap();
+    let err = write_files(&files).unwrap_err();
+    assert_eq!(err.to_string(), format!("{}: Is a directory (os error 21)", dir.path().join("c.exr").display()));
+    assert_eq!(fs::read(dir.path().join("a.png")).unwrap(), b"older a");
+    assert_eq!(fs::read(dir.path().join("b.ppm")).unwrap(), b"older b");
+    assert_eq!(strays(dir.path(), &[]), ["a.png", "b.ppm", "c.exr"]);
+    fs::remove_dir(dir.path().join("c.exr")).unwrap();
+    write_files(&files).unwrap();
+    for n in names {
+        assert_eq!(read_image(&dir.path().join(n)).unwrap().to_rgb8(), film.to_rgb8(), "{n}");
+    }
+    assert_eq!(strays(dir.path(), &[]), names);
+}
+
+#[test]
+fn write_temporary_names_fit_the_file_system_whenever_the_target_does() {
+    // A 255-byte name (the usual NAME_MAX): its temporary file, `.<name>.<pid>.<n>.tmp`, would not fit.
+    let dir = tempfile::tempdir().unwrap();
+    // The cut the temporary name makes (at 200 bytes) falls inside the two bytes of 'é'.
+    let target = dir.path().join(format!("{}é{}.png", "a".repeat(199), "a".repeat(50)));
+    assert_eq!(target.file_name().unwrap().len(), 255);
+    arbor::image_io::write_image(&target, &level_film(2, 2)).unwrap();
+    assert_eq!(strays(dir.path(), &[]), [target.file_name().unwrap().to_str().unwrap()]);
 }

@@ -41,6 +41,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("material", 3),
     ("texture", 3),
     ("scene::geometry", 3),
+    ("scene::clearance", 3),
     ("scene::runtime", 3),
     // The build step: description -> runtime scene, loading assets.
     ("scene::build", 4),

@@ -218,6 +218,7 @@ fn ray_offset_error_bound_whitted_render_has_no_self_shadowing() {
             width: 48,
             height: 48,
             image_name: "x.png".into(),
+            name_loc: Location::file("test"),
             num_samples: 1,
             transform: Transform::IDENTITY,
             lens: None,

@@ -8,11 +8,16 @@
 //! default such a scene is rendered at no more than [`FEW_SAMPLES`] samples per pixel (block means still
 //! average hundreds of samples); the ignored test `reference_full_samples` renders every sample.
 //!
-//! The 2024 set has references without back-face culling (`outputs_nobfc/`), compared with an unculled
-//! render, and with it (`outputs/`), compared with a culled render wherever the two references differ.
-//! The 2025 references are the culled ones; the 2022 hw2 ones unculled (`grass/README.txt` says so, and
-//! the other scenes look the same either way); the 2022 hw4 ones unculled too. A scene whose mesh files
-//! are missing is skipped, by name.
+//! Scenes are rendered with the default culling (as `arbor render` without `--cull` or `--no-cull`): the
+//! 2025 JSON form culls back faces of camera rays, and its references are the culled ones; the XML
+//! form does not, and the 2022 references are unculled (hw2's `grass/README.txt` says so, and the other
+//! scenes look the same either way). The 2024 set has references without back-face culling
+//! (`outputs_nobfc/`), compared with the default render, and with it (`outputs/`), compared with a render
+//! with `--cull` wherever the two references differ. A scene whose mesh files are missing is skipped, by
+//! name.
+//!
+//! An image compared with an unculled reference must not get the warning of `arbor render` that most
+//! of its camera rays meet back faces ([`back_face_share`]).
 //!
 //! Each test writes its results as a Markdown table to `$CARGO_TARGET_TMPDIR` (collected into
 //! `docs/reference-results.md`).
@@ -27,7 +32,7 @@ use arbor::accel::AccelConfig;
 use arbor::film::Film;
 use arbor::image_io::metrics::{compare_blocks_rgb8, compare_rgb8};
 use arbor::image_io::{is_hdr_path, read_image, read_rgb8};
-use arbor::render::{render, RenderOptions};
+use arbor::render::{back_face_share, render, RenderOptions, BACK_FACE_WARNING_SHARE};
 use arbor::scene::{load_desc, Scene};
 use arbor::tonemap::luminance;
 
@@ -54,7 +59,8 @@ struct Case {
     scene: PathBuf,
     camera: usize,
     reference: PathBuf,
-    cull: bool,
+    /// `--cull` (`Some(true)`), `--no-cull` (`Some(false)`) or neither (the scene's and its form's default).
+    cull: Option<bool>,
 }
 
 /// The reference of camera `camera` of `scene` in `outputs`: the image name as PNG in the same sub-folder,
@@ -86,8 +92,18 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, max_spp: Option<u32>
         let scene = &current.as_ref().unwrap().1;
         let spp = scene.cameras[case.camera].num_samples;
         let samples = max_spp.map_or(spp, |m| spp.min(m));
+        let opts = RenderOptions { cull_backfaces: case.cull, spp: Some(samples), ..Default::default() };
+        let culled = case.cull.or(scene.cull_backfaces).unwrap_or(false);
+        // An unculled reference is what the scene expects: `arbor render` must not suggest `--cull`.
+        let back_faces = back_face_share(scene, case.camera);
+        if !culled && back_faces > BACK_FACE_WARNING_SHARE {
+            failures.push(format!(
+                "{}: unculled reference, but {:.1}% of camera rays meet back faces",
+                case.reference.display(),
+                back_faces * 100.0
+            ));
+        }
         let start = Instant::now();
-        let opts = RenderOptions { cull_backfaces: Some(case.cull), spp: Some(samples), ..Default::default() };
         let (film, _) = render(scene, case.camera, &opts, &|_, _| {}).unwrap();
         let secs = start.elapsed().as_secs_f64();
         let name = case.scene.file_name().unwrap().to_string_lossy().to_string();
@@ -117,7 +133,7 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, max_spp: Option<u32>
         let _ = writeln!(
             table,
             "| {name} | {image} | {} | {w}x{h} | {sampled} | {:.2} | {metric} | {:.3}% | {:.1}% | {:+.2} {:+.2} {:+.2} | {secs:.2} |",
-            if case.cull { "on" } else { "off" },
+            if culled { "on" } else { "off" },
             c.psnr,
             share * 100.0,
             limit * 100.0,
@@ -125,15 +141,10 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, max_spp: Option<u32>
             bias[1],
             bias[2],
         );
-        println!(
-            "{name} -> {image} (culling {}, {sampled} spp): {metric} {:.3}% in {secs:.2} s",
-            case.cull,
-            share * 100.0
-        );
+        println!("{name} -> {image} (culling {culled}, {sampled} spp): {metric} {:.3}% in {secs:.2} s", share * 100.0);
         if share > limit {
             failures.push(format!(
-                "{name} -> {image} (culling {}, {sampled} spp): {:.3}% {metric} (limit {:.1}%)",
-                case.cull,
+                "{name} -> {image} (culling {culled}, {sampled} spp): {:.3}% {metric} (limit {:.1}%)",
                 share * 100.0,
                 limit * 100.0
             ));
@@ -227,7 +238,7 @@ fn check(failures: Vec<String>) {
 }
 
 /// Cases of one METU set: every scene file under `inputs`, each camera against its reference(s).
-fn metu_cases(root: &Path, ext: &str, refs: &[(&str, bool)]) -> (Vec<Case>, Vec<String>) {
+fn metu_cases(root: &Path, ext: &str, refs: &[(&str, Option<bool>)]) -> (Vec<Case>, Vec<String>) {
     let inputs = root.join("inputs");
     let (mut cases, mut skipped) = (Vec::new(), Vec::new());
     for scene in common::scene_files(&inputs, ext) {
@@ -262,7 +273,7 @@ fn metu_cases(root: &Path, ext: &str, refs: &[(&str, bool)]) -> (Vec<Case>, Vec<
 fn reference_ceng795_2024_xml() {
     let Some(dir) = common::scenes_dir() else { return };
     let (cases, skipped) =
-        metu_cases(&dir.join("ceng795-2024-hw1/hw1"), "xml", &[("outputs_nobfc", false), ("outputs", true)]);
+        metu_cases(&dir.join("ceng795-2024-hw1/hw1"), "xml", &[("outputs_nobfc", None), ("outputs", Some(true))]);
     assert!(cases.len() >= 15, "only {} cases found", cases.len());
     check(run("CENG 795 2024 XML", cases, skipped, None).1);
 }
@@ -270,21 +281,21 @@ fn reference_ceng795_2024_xml() {
 #[test]
 fn reference_ceng795_2025_json() {
     let Some(dir) = common::scenes_dir() else { return };
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2025-json/hw1"), "json", &[("outputs", true)]);
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2025-json/hw1"), "json", &[("outputs", None)]);
     assert!(cases.len() >= 15, "only {} cases found", cases.len());
     check(run("CENG 795 2025 JSON", cases, skipped, None).1);
 }
 
 /// The 2022 hw2 scenes (transformations, instancing).
 fn hw2_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw2"), "xml", &[("outputs", false)]);
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw2"), "xml", &[("outputs", None)]);
     assert!(cases.len() >= 6, "only {} cases found", cases.len());
     (cases, skipped)
 }
 
 /// The 2025 hw3 scenes (distribution ray tracing).
 fn hw3_2025(dir: &Path) -> (Vec<Case>, Vec<String>) {
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2025-json/hw3"), "json", &[("outputs", true)]);
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2025-json/hw3"), "json", &[("outputs", None)]);
     assert!(cases.len() >= 5, "only {} cases found", cases.len());
     (cases, skipped)
 }
@@ -298,7 +309,7 @@ fn reference_ceng795_2022_hw2() {
 
 /// The 2022 hw4 scenes (textures), unculled: every one, Veach's "ajar" scene included.
 fn hw4_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw4"), "xml", &[("outputs", false)]);
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw4"), "xml", &[("outputs", None)]);
     assert!(cases.len() >= 22, "only {} cases found", cases.len());
     (cases, skipped)
 }
@@ -334,13 +345,13 @@ fn reference_full_samples() {
 /// output with a tone mapping, compared as the tone-mapped PNG and in relative radiance): the 2022 set,
 /// and the same scene files with the 2019 references beside them.
 fn hw6_direct_lighting(dir: &Path) -> (Vec<Case>, Vec<String>) {
-    let (mut cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw6/directLighting"), "xml", &[("outputs", false)]);
+    let (mut cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw6/directLighting"), "xml", &[("outputs", None)]);
     let old = dir.join("ceng795-2019/inputs/hw6/directLighting");
     for scene in common::scene_files(&old, "xml") {
         let desc = load_desc(&scene).unwrap_or_else(|e| panic!("{e}"));
         for (camera, cam) in desc.cameras.iter().enumerate() {
             let reference = reference_for(&old, &old, &scene, &cam.image_name);
-            cases.push(Case { scene: scene.clone(), camera, reference, cull: false });
+            cases.push(Case { scene: scene.clone(), camera, reference, cull: None });
         }
     }
     assert!(cases.len() >= 14, "only {} cases found", cases.len());
@@ -386,7 +397,7 @@ fn reference_nyu_bunny() {
     let scene = tmp.path().join("bunny.json");
     std::fs::write(&scene, text).unwrap();
     let reference = dir.join("nyu-cg-assignment4/Assignment_4/img/bunny.png");
-    let cases = vec![Case { scene, camera: 0, reference, cull: false }];
+    let cases = vec![Case { scene, camera: 0, reference, cull: None }];
     check(run("NYU bunny", cases, Vec::new(), None).1);
 }
 
@@ -394,7 +405,7 @@ fn reference_nyu_bunny() {
 /// killeroo images), listed as skipped.
 fn hw6_brdf_2022(dir: &Path) -> (Vec<Case>, Vec<String>) {
     let root = dir.join("ceng795-2022/hw6/brdf");
-    let (cases, mut skipped) = metu_cases(&root, "xml", &[("outputs", false)]);
+    let (cases, mut skipped) = metu_cases(&root, "xml", &[("outputs", None)]);
     assert!(cases.len() >= 7, "only {} cases found", cases.len());
     for png in common::scene_files(&root.join("outputs"), "png") {
         if !cases.iter().any(|c| c.reference == png) {
@@ -440,7 +451,7 @@ const HW5_EXCLUDED: &[(&str, &str)] = &[(
 
 /// The 2022 hw5 scenes (HDR output, tone mapping, directional, spot and environment lights).
 fn hw5_2022(dir: &Path) -> (Vec<Case>, Vec<Case>, Vec<String>) {
-    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw5"), "xml", &[("outputs", false)]);
+    let (cases, skipped) = metu_cases(&dir.join("ceng795-2022/hw5"), "xml", &[("outputs", None)]);
     let excluded = |c: &Case| HW5_EXCLUDED.iter().any(|(f, _)| c.scene.file_name().is_some_and(|n| n == *f));
     let (out, kept): (Vec<Case>, Vec<Case>) = cases.into_iter().partition(excluded);
     assert!(kept.len() >= 2, "only {} cases found", kept.len());

@@ -44,6 +44,7 @@ fn neutral(mut d: SceneDesc) -> SceneDesc {
     d.warnings.clear();
     for c in &mut d.cameras {
         c.loc = nowhere.clone();
+        c.name_loc = nowhere.clone();
     }
     for o in &mut d.objects {
         o.loc = nowhere.clone();
@@ -65,7 +66,8 @@ fn readers_xml_and_json_forms_give_equal_descriptions() {
     assert_eq!((x.radiance_scale, j.radiance_scale), (1.0 / 255.0, 1.0 / 255.0));
     assert_eq!((x.shadow_epsilon, x.intersection_epsilon), (j.shadow_epsilon, j.intersection_epsilon));
     assert_eq!((x.max_depth, j.max_depth), (4, 4));
-    assert_eq!(x.cull_backfaces, j.cull_backfaces);
+    // The one setting the forms differ in by default: the JSON form culls (see the test below).
+    assert_eq!((x.cull_backfaces, j.cull_backfaces), (None, Some(true)));
     assert_eq!(x.ambient, j.ambient);
     assert_eq!(x.environment, j.environment);
     assert_eq!(x.cameras, j.cameras);
@@ -73,6 +75,21 @@ fn readers_xml_and_json_forms_give_equal_descriptions() {
     assert_eq!(x.materials, j.materials);
     assert_eq!(x.objects, j.objects);
     assert_eq!((x.cameras.len(), x.materials.len(), x.objects.len()), (2, 4, 5));
+}
+
+#[test]
+fn readers_json_form_culls_camera_rays_unless_the_scene_says_otherwise() {
+    // The 2025 JSON form's official images are culled; the XML form leaves culling to the user.
+    let with = |name: &str, at: &str, element: &str| {
+        let text = std::fs::read_to_string(fixture(name)).unwrap();
+        let i = text.find(at).unwrap() + at.len();
+        arbor::scene::parse_desc(&format!("{}{element}{}", &text[..i], &text[i..]), &fixture(name)).unwrap()
+    };
+    assert_eq!(with("pair.json", "\"Scene\": {", "").cull_backfaces, Some(true));
+    assert_eq!(with("pair.json", "\"Scene\": {", "\"BackfaceCulling\": \"false\",").cull_backfaces, Some(false));
+    assert_eq!(with("pair.xml", "<Scene>", "").cull_backfaces, None);
+    assert_eq!(with("pair.xml", "<Scene>", "<BackfaceCulling>true</BackfaceCulling>").cull_backfaces, Some(true));
+    assert_eq!(with("pair.xml", "<Scene>", "<BackfaceCulling>0</BackfaceCulling>").cull_backfaces, Some(false));
 }
 
 #[test]
@@ -252,6 +269,7 @@ fn readers_nyu_parallelogram_and_located_errors() {
     std::fs::write(&path, text).unwrap();
     let d = load_desc(&path).unwrap();
     assert_eq!((d.radiance_scale, d.max_depth, d.shadow_epsilon, d.shadows), (1.0, 0, 1e-4, false));
+    assert_eq!((d.flip_back_faces, d.cull_backfaces), (true, Some(false)));
     assert!(d.cameras[0].orthographic);
     assert_eq!(d.cameras[0].image_name, "quad.png");
     let glass = MaterialKind::Transparent { eta: 1.3, transparency: Vec3::splat(0.5), mirror: Vec3::ZERO };

@@ -352,3 +352,43 @@ fn two_level_a_moving_object_is_where_its_motion_puts_it_at_the_rays_time() {
     assert!(moved_hits > 1_000, "too few hits on moved objects: {moved_hits}");
     assert!(agree as f64 >= 0.999 * total as f64, "{agree} of {total} hits on the same primitive");
 }
+
+/// A bumpy `n` x `n` grid of quads (2n² triangles).
+fn grid(n: u32) -> Arc<TriangleMesh> {
+    let at = |i: u32, j: u32| Vec3::new(i as f32, j as f32, ((i * 7 + j * 13) % 5) as f32 * 0.3);
+    let positions = (0..=n).flat_map(|j| (0..=n).map(move |i| at(i, j))).collect();
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let indices = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| [[v(i, j), v(i + 1, j), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i, j + 1)]])
+        })
+        .collect();
+    Arc::new(TriangleMesh { positions, indices, ..Default::default() })
+}
+
+#[test]
+fn two_level_build_time_is_the_wall_time_of_the_parallel_build() {
+    // Eight meshes built on four threads: the structures' own build times, summed, exceed the wall
+    // time of the whole build. What is reported must not (a consistency check, not a speed check).
+    let meshes: Vec<ObjectDesc> = (0..8)
+        .map(|k| {
+            object(
+                &format!("m{k}"),
+                ShapeDesc::Mesh { source: MeshSource::Inline(grid(70)), smooth: false },
+                Transform::translate(Vec3::new(0.0, 0.0, k as f32)),
+            )
+        })
+        .collect();
+    let d = desc(meshes);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+    for kind in [AccelKind::KdTree, AccelKind::BvhSah, AccelKind::Octree] {
+        let start = std::time::Instant::now();
+        let g = pool.install(|| build_geometry(&d, &AccelConfig::from(kind))).unwrap();
+        let elapsed = start.elapsed();
+        let built = g.accel_stats().build_time;
+        assert!(
+            built > std::time::Duration::ZERO && built <= elapsed,
+            "{kind}: built in {built:?}, {elapsed:?} in all"
+        );
+    }
+}

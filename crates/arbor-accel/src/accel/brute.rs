@@ -64,7 +64,7 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
         best.hit()
     }
 
-    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+    fn boxes_at_depth(&self, _: &P, depth: usize) -> Vec<Aabb> {
         if depth == 0 && !self.bounds.is_empty() {
             vec![self.bounds]
         } else {

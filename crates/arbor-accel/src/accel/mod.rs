@@ -247,8 +247,11 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
     fn validate(&self, prims: &P) -> Result<(), String>;
     /// [`Accel::intersect`], adding the nodes visited and primitives tested to `counts`.
     fn intersect_counted(&self, prims: &P, ray: &Ray, t_max: f32, counts: &mut TraversalCounts) -> Option<Hit>;
-    /// The boxes of the nodes (cells) at `depth` below the root, for the boxes debug view.
-    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb>;
+    /// The boxes of the nodes (cells) at `depth` below the root (which has depth 0), for the boxes debug
+    /// view: the nodes whose depths [`Accel::stats`] counts (a BVH's binary tree, not the 8-wide tree
+    /// its queries read), so `stats().max_depth` is the deepest level with a box. An octree leaves out
+    /// its empty leaves (regions holding nothing).
+    fn boxes_at_depth(&self, prims: &P, depth: usize) -> Vec<Aabb>;
     /// [`Accel::intersect`] for a batch: `out[i]` becomes the closest hit of `rays[i]` in
     /// `(0, t_max[i])`, the same hit as a query of its own. A structure may trace several rays at once
     /// (the BVH interleaves two); the default asks one query per ray.

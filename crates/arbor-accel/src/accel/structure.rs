@@ -221,6 +221,28 @@ mod tests {
         assert!(Arc::strong_count(&shared) == 1, "structures dropped with their share of the mesh");
     }
 
+    /// The boxes view's levels are the ones the statistics count: for every structure, each depth from
+    /// the root's (0) to `max_depth` has boxes, none below, and they are all the nodes the statistics
+    /// count (but an octree's empty leaves, which hold nothing).
+    #[test]
+    fn structure_boxes_at_each_depth_are_the_nodes_the_statistics_count() {
+        let mesh = soup(3000, 11);
+        for &kind in AccelKind::ALL {
+            let accel = build(kind, &mesh);
+            let s = accel.stats();
+            let levels: Vec<usize> = (0..=s.max_depth + 1).map(|d| accel.boxes_at_depth(&mesh, d).len()).collect();
+            assert!(levels[..=s.max_depth].iter().all(|&n| n > 0), "{kind}: boxes per level {levels:?}");
+            assert_eq!(levels[s.max_depth + 1], 0, "{kind}: boxes below depth max {}: {levels:?}", s.max_depth);
+            let total: usize = levels.iter().sum();
+            if kind == AccelKind::Octree {
+                assert!(total <= s.nodes && total > s.nodes - s.leaves, "{kind}: {total} boxes, {s:?}");
+            } else {
+                assert_eq!(total, s.nodes, "{kind}: {levels:?}");
+            }
+            assert!(s.max_depth > 0 || kind == AccelKind::Brute, "{kind}: a tree that does not test depths");
+        }
+    }
+
     #[test]
     fn structure_build_refuses_parameters_outside_their_range() {
         let config = AccelConfig::Octree(crate::accel::OctreeParams { max_depth: 40, ..Default::default() });

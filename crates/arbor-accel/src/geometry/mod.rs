@@ -1,5 +1,6 @@
 //! Shapes and their ray intersection: triangle meshes (flat arrays), spheres, infinite planes.
 
+mod closest_point;
 #[doc(hidden)]
 pub mod error_bound;
 mod mesh;
@@ -10,6 +11,7 @@ mod triangle4;
 mod triangle_box;
 mod triangle_clip;
 
+pub use closest_point::closest_point_on_triangle;
 pub use mesh::{MeshError, MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;

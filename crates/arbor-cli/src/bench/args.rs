@@ -46,7 +46,8 @@ pub struct BenchArgs {
     /// One JSON document on standard output instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Lift the limits on image size and recursion depth (as `arbor render --no-limits`).
+    /// Lift the limits on image size, recursion depth and the pixels of the images a scene reads (as
+    /// `arbor render --no-limits`).
     #[arg(long)]
     pub no_limits: bool,
 }

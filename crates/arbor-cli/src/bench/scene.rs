@@ -45,11 +45,13 @@ pub fn run(args: &BenchArgs) -> Result<(), Failure> {
     args.threads.apply()?;
     let specs = specs(&args.accel.clone().unwrap_or_else(all).0, &args.accel_params)?;
     let desc = load_input(&args.input, args.size)?;
-    arbor::scene::check_limits(&desc, None, &crate::render::limits(args.no_limits))?;
+    let limits = crate::render::limits(args.no_limits);
+    arbor::scene::check_limits(&desc, None, &limits)?;
+    let build = |spec: &AccelConfig| Scene::build_within(desc.clone(), spec, None, &limits.images);
     if desc.cameras.is_empty() {
         return Err(arbor::Error::Invalid(format!("{}: the scene has no camera", args.input)).into());
     }
-    let reference = Scene::build(desc.clone(), &AccelConfig::from(REFERENCE), None)?;
+    let reference = build(&AccelConfig::from(REFERENCE))?;
     let primary = primary_rays(&reference.cameras[0]);
     let (primary_hits, _) = trace(&reference.geometry, &primary);
     let diffuse = diffuse_rays(&reference, &primary, &primary_hits);
@@ -63,7 +65,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Failure> {
 
     eprintln!("bench: tracing a sample with brute force");
     let brute_max = args.brute_rays.map_or((BRUTE_BUDGET / prims.max(1)).clamp(64, 4096), |n| n as usize);
-    let brute_scene = Scene::build(desc.clone(), &AccelConfig::Brute, None)?;
+    let brute_scene = build(&AccelConfig::Brute)?;
     let brute: Vec<SetResult> = sets.iter().map(|s| measure(&brute_scene, s, Some(brute_max), args.runs)).collect();
     let brute_stats = brute_scene.geometry.accel_stats();
     drop(brute_scene);
@@ -77,7 +79,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Failure> {
         }
         // Progress on standard error: a slow structure should not look like a hang.
         eprintln!("bench: tracing with {}", spec.kind());
-        let scene = Scene::build(desc.clone(), spec, None)?;
+        let scene = build(spec)?;
         let results = sets.iter().map(|s| measure(&scene, s, None, args.runs)).collect();
         // Named by what was asked for: a structure may report another's name while it delegates.
         rows.push((AccelStats { kind: spec.kind().name(), ..scene.geometry.accel_stats() }, results));

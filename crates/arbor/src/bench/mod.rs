@@ -84,6 +84,7 @@ pub fn framing_camera(bounds: Aabb, width: u32, height: u32) -> CameraDesc {
         width,
         height,
         image_name: "bench.png".into(),
+        name_loc: Location::file("bench"),
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,

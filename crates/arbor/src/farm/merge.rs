@@ -8,14 +8,15 @@
 //! Algorithm: parts are visited by sample start; a per-pixel counter holds the next sample expected, so a
 //! part starting below it overlaps an earlier part and one starting above it leaves a gap no later part
 //! can fill. Sums are exact integers, so the order of addition does not change the result. Cost: one
-//! pass over every part's pixels, two `u32` per frame pixel.
+//! pass over every part's pixels, two `u32` and a sum per frame pixel, allocated fallibly.
 
 use std::path::PathBuf;
 
 use crate::accum::SampleSum;
 use crate::error::{Error, Location, Result};
 use crate::farm::Partial;
-use crate::film::Film;
+use crate::film::{try_filled, Film};
+use crate::math::Color;
 
 /// Merges `parts` (each with the file it came from, for messages) into the full frame.
 pub fn merge(parts: &[(PathBuf, Partial)]) -> Result<Film> {
@@ -42,9 +43,9 @@ pub fn merge(parts: &[(PathBuf, Partial)]) -> Result<Film> {
         }
     }
     let (w, h) = f.frame;
-    let mut next = vec![0u32; w as usize * h as usize];
-    let mut by = vec![u32::MAX; next.len()];
-    let mut total = vec![SampleSum::default(); next.len()];
+    let mut next = try_filled(0u32, w, h)?;
+    let mut by = try_filled(u32::MAX, w, h)?;
+    let mut total = try_filled(SampleSum::default(), w, h)?;
     let mut order: Vec<usize> = (0..parts.len()).collect();
     order.sort_by_key(|&i| (parts[i].1.sums.samples.0, parts[i].1.sums.window.1, parts[i].1.sums.window.0));
     for i in order {
@@ -71,8 +72,11 @@ pub fn merge(parts: &[(PathBuf, Partial)]) -> Result<Film> {
     if let Some(at) = next.iter().position(|&k| k != f.spp) {
         return Err(missing(at as u32 % w, at as u32 / w, next[at], f.spp));
     }
-    let pixels = total.iter().map(|s| s.value(f.scale, f.spp)).collect();
-    Ok(Film { width: w, height: h, pixels })
+    let mut film = Film { width: w, height: h, pixels: try_filled(Color::ZERO, w, h)? };
+    for (p, s) in film.pixels.iter_mut().zip(&total) {
+        *p = s.value(f.scale, f.spp);
+    }
+    Ok(film)
 }
 
 fn missing(x: u32, y: u32, from: u32, to: u32) -> Error {

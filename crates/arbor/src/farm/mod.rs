@@ -13,7 +13,7 @@ pub mod merge;
 pub mod partial;
 
 pub use merge::merge;
-pub use partial::{read_partial, write_partial, Partial};
+pub use partial::{decode_partial, encode_partial, read_partial, write_partial, Partial};
 
 /// The tile grid for `n` tiles over a `w` x `h` frame, as `(cols, rows)` with `cols * rows == n`: of the
 /// factorisations that give every tile at least one pixel, the one whose cells are closest to square

@@ -15,6 +15,10 @@
 //!   the merged image is written as the single-process render writes it.
 //!
 //! Written atomically like every image; read back with every field checked, errors naming the file.
+//! Before any pixel is read, the header is held to a budget: the frame (display window) and the slice
+//! (data window) at most the limit's pixels, at most 64 bytes a pixel (the sixteen 32-bit channels
+//! above); the channels the exr crate then allocates are reserved first, so that a file too large for
+//! the memory is an error, not an abort.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -23,6 +27,7 @@ use exr::prelude::*;
 
 use crate::accum::SampleSum;
 use crate::error::{Error, Location, Result};
+use crate::image_io::ImageLimits;
 use crate::render::RenderSums;
 use crate::tonemap::{Operator, Tonemap};
 
@@ -45,6 +50,11 @@ const TONEMAP_FIELDS: [&str; 5] =
 
 /// Writes `part` to `path` (atomically: a temporary file renamed over the target).
 pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
+    crate::image_io::write::write_atomic(path, &encode_partial(path, part)?)
+}
+
+/// The bytes [`write_partial`] writes to `path` (named in a failure to encode).
+pub fn encode_partial(path: &Path, part: &Partial) -> Result<Vec<u8>> {
     let s = &part.sums;
     let (x0, y0, x1, y1) = s.window;
     let count = s.samples.1 - s.samples.0;
@@ -82,24 +92,59 @@ pub fn write_partial(path: &Path, part: &Partial) -> Result<()> {
         .write()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
-    crate::image_io::write::write_atomic(path, &bytes.into_inner())
+    Ok(bytes.into_inner())
 }
 
-/// Reads a partial image written by [`write_partial`].
-pub fn read_partial(path: &Path) -> Result<Partial> {
-    let bytes = crate::input::load_bytes(path)?;
+/// Bytes of a pixel of a partial: the 16 channels of 4 bytes each.
+const PIXEL_BYTES: usize = 4 * (CHANNELS.len() * 5 + 1);
+
+/// Reads a partial image written by [`write_partial`], its frame and window held to `limits` (those of
+/// an image `render` may write: [`crate::scene::SceneLimits::rendered`]).
+pub fn read_partial(path: &Path, limits: &ImageLimits) -> Result<Partial> {
+    decode_partial(&crate::input::load_bytes(path)?, path, limits)
+}
+
+/// [`read_partial`] of the file `bytes`, named `path` in errors.
+pub fn decode_partial(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<Partial> {
     let bad = |msg: String| Error::input(Location::file(path), msg);
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(Cursor::new(bytes))
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
         .map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
+    let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());
+    if !meta.headers.iter().any(|h| h.own_attributes.other.contains_key(&Text::from("arbor.render"))) {
+        return Err(not_partial());
+    }
+    for header in &meta.headers {
+        // Tiles (which the exr crate mixes up across resolution levels when a block claims a level the
+        // header has not) are never in a partial.
+        if header.blocks != exr::meta::BlockDescription::ScanLines || header.deep {
+            return Err(bad(
+                "not a partial image of `arbor render` (it is tiled or deep, a partial is flat scan lines)".into(),
+            ));
+        }
+        let frame = header.shared_attributes.display_window.size;
+        limits.check_area("the frame", frame.width() as u64, frame.height() as u64, path)?;
+        let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        limits.check_area("the data window", w as u64, h as u64, path)?;
+        let per_pixel = header.channels.bytes_per_pixel;
+        if per_pixel > PIXEL_BYTES {
+            let n = header.channels.list.len();
+            return Err(bad(format!(
+                "not a partial image of `arbor render` ({n} channels of {per_pixel} bytes a pixel, more than a \
+                 partial's {PIXEL_BYTES})"
+            )));
+        }
+        // Reserved and given back: the exr crate allocates the channels itself.
+        let need = (w as u64).saturating_mul(h as u64).saturating_mul(per_pixel as u64);
+        drop(crate::image_io::try_vec::<u8>(need, w as u32, h as u32, "read it", path)?);
+    }
+    // Pedantic: a partial is Arbor's own file, and written by the same crate.
+    let reader = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+    let reader = reader.pedantic();
+    let reader = if crate::image_io::exr_in_parallel(&meta.headers) { reader } else { reader.non_parallel() };
+    let image =
+        reader.from_buffered(Cursor::new(bytes)).map_err(|e| bad(format!("not a readable OpenEXR file: {e}")))?;
     let layer = &image.layer_data;
     let a = &layer.attributes.other;
-    let not_partial = || bad("not a partial image of `arbor render` (no arbor.render attribute)".into());
     let text = |k: &str| match a.get(&Text::from(k)) {
         Some(AttributeValue::Text(t)) => Some(t.to_string()),
         _ => None,
@@ -147,6 +192,7 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
         )));
     }
     let n = size.0 * size.1;
+    let mut sums = crate::film::try_filled(SampleSum::default(), size.0 as u32, size.1 as u32)?;
     let channel = |name: &str| -> Result<&[u32]> {
         match layer.channel_data.list.iter().find(|c| c.name.to_string() == name).map(|c| &c.sample_data) {
             Some(FlatSamples::U32(v)) if v.len() == n => Ok(v),
@@ -156,7 +202,6 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
     if let Some(i) = channel("W")?.iter().position(|&w| w != k1 - k0) {
         return Err(bad(format!("weight W of pixel {i} of the window is not {} (samples {k0}..{k1})", k1 - k0)));
     }
-    let mut sums = vec![SampleSum::default(); n];
     for (c, name) in CHANNELS.iter().enumerate() {
         for limb in 0..4 {
             for (s, &bits) in sums.iter_mut().zip(channel(&format!("sum{name}{limb}"))?) {
@@ -166,4 +211,22 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
     }
     let sums = RenderSums { frame, window, spp, samples: (k0, k1), scale, sums };
     Ok(Partial { identity, camera, tonemap, sums })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn partial_in_tiles_is_refused_before_its_blocks_are_read() {
+        let mut attributes = LayerAttributes::default();
+        attributes.other.insert(Text::from("arbor.render"), AttributeValue::Text(Text::from("x")));
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32));
+        let layer = Layer::new((2, 2), attributes, Encoding::FAST_LOSSLESS, channels);
+        let mut bytes = Cursor::new(Vec::new());
+        Image::from_layer(layer).write().to_buffered(&mut bytes).unwrap();
+        let e = decode_partial(bytes.get_ref(), Path::new("t.exr"), &ImageLimits::DEFAULT).unwrap_err();
+        let msg = "t.exr: not a partial image of `arbor render` (it is tiled or deep, a partial is flat scan lines)";
+        assert_eq!(e.to_string(), msg);
+    }
 }

@@ -3,7 +3,7 @@
 //! channel, image minus reference).
 //!
 //! All statistics are over the three channels of every pixel (alpha is never compared: [`compare_files`]
-//! reads both images with [`read_rgb8`](super::read_rgb8)). PSNR uses a peak of 255:
+//! reads both images as 8-bit RGB with [`read`](super::read), within the pixel budget it is given). PSNR uses a peak of 255:
 //! `10 log10(255^2 / MSE)`, infinite for identical images. A pixel is "off" when any of its channels
 //! differs by strictly more than the threshold, so threshold 0 counts every difference. Cost: one pass.
 //!
@@ -16,6 +16,7 @@
 use std::path::Path;
 
 use super::levels::BlockLevels;
+use super::ImageLimits;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::math::Color;
@@ -262,11 +263,11 @@ fn band_sums(reference: &[u8], image: &[u8], row: usize, k: usize, sums: &mut [[
     }
 }
 
-/// Reads both files as 8-bit RGB: their common size and pixels; an error when they cannot be read or differ
-/// in size.
-fn read_pair(reference: &Path, image: &Path) -> Result<(u32, u32, Vec<u8>, Vec<u8>)> {
-    let (rw, rh, ref_px) = super::read_rgb8(reference)?;
-    let (w, h, img_px) = super::read_rgb8(image)?;
+/// Reads both files as 8-bit RGB within `limits`: their common size and pixels; an error when they cannot
+/// be read or differ in size.
+fn read_pair(reference: &Path, image: &Path, limits: &ImageLimits) -> Result<(u32, u32, Vec<u8>, Vec<u8>)> {
+    let (rw, rh, ref_px) = super::read(reference, limits)?;
+    let (w, h, img_px) = super::read(image, limits)?;
     if (rw, rh) != (w, h) {
         return Err(Error::Invalid(format!(
             "{} is {w}x{h} but the reference {} is {rw}x{rh}",
@@ -277,19 +278,26 @@ fn read_pair(reference: &Path, image: &Path) -> Result<(u32, u32, Vec<u8>, Vec<u
     Ok((w, h, ref_px, img_px))
 }
 
-/// Reads both files as 8-bit RGB and compares them; an error when they cannot be read or differ in size.
-pub fn compare_files(reference: &Path, image: &Path, threshold: u8) -> Result<Comparison> {
-    let (w, h, ref_px, img_px) = read_pair(reference, image)?;
+/// Reads both files as 8-bit RGB within `limits` and compares them; an error when they cannot be read or
+/// differ in size.
+pub fn compare_files(reference: &Path, image: &Path, threshold: u8, limits: &ImageLimits) -> Result<Comparison> {
+    let (w, h, ref_px, img_px) = read_pair(reference, image, limits)?;
     Ok(compare_rgb8(&ref_px, &img_px, w, h, threshold))
 }
 
-/// Reads both files as 8-bit RGB and compares the means of their `block` x `block`-pixel blocks; an error
-/// when they cannot be read or differ in size.
+/// Reads both files as 8-bit RGB within `limits` and compares the means of their `block` x `block`-pixel
+/// blocks; an error when they cannot be read or differ in size.
 ///
 /// # Panics
 /// When `block` is 0.
-pub fn compare_blocks_files(reference: &Path, image: &Path, block: u32, threshold: u8) -> Result<BlockComparison> {
-    let (w, h, ref_px, img_px) = read_pair(reference, image)?;
+pub fn compare_blocks_files(
+    reference: &Path,
+    image: &Path,
+    block: u32,
+    threshold: u8,
+    limits: &ImageLimits,
+) -> Result<BlockComparison> {
+    let (w, h, ref_px, img_px) = read_pair(reference, image, limits)?;
     Ok(compare_blocks_rgb8(&ref_px, &img_px, w, h, block, threshold))
 }
 

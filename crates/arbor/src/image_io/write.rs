@@ -10,6 +10,11 @@
 //! before either is renamed, and should the second rename fail, the first target gets its previous
 //! contents back (kept meanwhile as a hard link, `.<name>.<pid>.<n>.old`) or is removed if it had none,
 //! so a failed run leaves the old pair or nothing, never a new image beside an old or missing PNG.
+//! [`write_files`] does the same for any set of encoded files ([`encode_outputs`]): `arbor render`
+//! writes all its cameras' images and its statistics as one set, after the last render.
+//!
+//! The temporary names keep at most [`NAME_KEPT`] bytes of the target's name, so they fit the file
+//! system's limit on a name (255 bytes on the usual ones) whenever the target's name does.
 
 use std::fs;
 use std::io::{Cursor, Write};
@@ -169,23 +174,30 @@ pub fn tone_mapped_beside(path: &Path) -> PathBuf {
 /// `tonemap` the tone-mapped PNG of the film beside it ([`tone_mapped_beside`]), replacing a file of that
 /// name. Returns the files written: all of them, atomically, or none (see the module documentation).
 pub fn write_outputs(path: &Path, film: &Film, unit: f32, tonemap: Option<&Tonemap>) -> Result<Vec<PathBuf>> {
+    let files = encode_outputs(path, film, unit, tonemap)?;
+    write_files(&files)?;
+    Ok(files.into_iter().map(|(p, _)| p).collect())
+}
+
+/// The files [`write_outputs`] writes, encoded in memory: the image, and the PNG beside an HDR one.
+pub fn encode_outputs(
+    path: &Path,
+    film: &Film,
+    unit: f32,
+    tonemap: Option<&Tonemap>,
+) -> Result<Vec<(PathBuf, Vec<u8>)>> {
     if is_hdr_path(path) {
-        let radiance = in_radiance(film, unit);
-        let image = encoded(path, &radiance)?;
-        let Some(tm) = tonemap else {
-            write_atomic(path, &image)?;
-            return Ok(vec![path.to_path_buf()]);
-        };
+        let image = (path.to_path_buf(), encoded(path, &in_radiance(film, unit))?);
+        let Some(tm) = tonemap else { return Ok(vec![image]) };
         let png = tone_mapped_beside(path);
         let preview = encoded(&png, &tm.apply(film))?;
-        write_atomic_set(&[(path, &image), (&png, &preview)])?;
-        return Ok(vec![path.to_path_buf(), png]);
+        return Ok(vec![image, (png, preview)]);
     }
-    match tonemap {
-        Some(tm) => write_image(path, &tm.apply(film))?,
-        None => write_image(path, film)?,
-    }
-    Ok(vec![path.to_path_buf()])
+    let bytes = match tonemap {
+        Some(tm) => encoded(path, &tm.apply(film))?,
+        None => encoded(path, film)?,
+    };
+    Ok(vec![(path.to_path_buf(), bytes)])
 }
 
 /// `film` over `unit`: display values back in the scene's radiance units.
@@ -195,6 +207,13 @@ fn in_radiance(film: &Film, unit: f32) -> std::borrow::Cow<'_, Film> {
     }
     let pixels = film.pixels.iter().map(|&c| c / unit).collect();
     std::borrow::Cow::Owned(Film { width: film.width, height: film.height, pixels })
+}
+
+/// Writes every `(path, bytes)` of `files` atomically, all or none: a failure leaves every target as
+/// it was (see the module documentation). The paths must be distinct.
+pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    let set: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (p.as_path(), b.as_slice())).collect();
+    write_atomic_set(&set)
 }
 
 /// Writes `bytes` to a fresh temporary file beside `path` and renames it over `path`.
@@ -287,11 +306,17 @@ fn folder_of(path: &Path) -> PathBuf {
     }
 }
 
+/// The most bytes of a target's name a temporary name keeps: with the dot, a 10-digit pid, a 20-digit
+/// count and the extension it stays under 255 bytes.
+pub const NAME_KEPT: usize = 200;
+
 /// `.<name>.<pid>.<n>.<ext>` beside `target`, unique per process and call, so parallel writers never
-/// share one.
+/// share one; `<name>` is the target's name cut to [`NAME_KEPT`] bytes (at a character boundary).
 fn fresh_name(target: &Path, ext: &str) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "image".to_string());
+    let mut name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "image".to_string());
+    let cut = (0..=NAME_KEPT.min(name.len())).rev().find(|&i| name.is_char_boundary(i)).unwrap_or(0);
+    name.truncate(cut);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     folder_of(target).join(format!(".{name}.{}.{n}.{ext}", std::process::id()))
 }

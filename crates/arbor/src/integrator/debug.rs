@@ -8,8 +8,10 @@
 //! - `heatmap`: the work of each camera ray (nodes visited plus primitives tested), divided by the
 //!   image's maximum and mapped through a turbo-like false-colour ramp, with a legend bar along the
 //!   bottom rows (left = 0, right = the maximum).
-//! - `boxes[:DEPTH]`: the normal Whitted render with the wireframe of the structure's boxes at `DEPTH`
-//!   projected over it.
+//! - `boxes[:DEPTH]`: the normal Whitted render with the wireframe of the nodes `DEPTH` levels below the
+//!   root of each structure (the top level's and every mesh's: [`crate::scene::SceneGeometry::boxes_at_depth`])
+//!   projected over it. The levels are the ones the statistics count (a BVH's binary tree's, not the
+//!   8-wide tree's), so depth `max_depth` of `arbor info` shows the deepest leaves.
 //!
 //! The per-pixel views trace one ray through each pixel centre; the image-wide steps (normalising the
 //! heatmap, drawing boxes) run once the film is complete ([`heatmap_finish`], [`overlay_boxes`]).
@@ -32,9 +34,9 @@ pub const BOX_COLOR: Color = Color::new(1.0, 0.0, 1.0);
 /// Which debug view to render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DebugView {
-    /// Whitted render with the structure's boxes at `depth` drawn as wireframe.
+    /// Whitted render with the structures' boxes at `depth` drawn as wireframe.
     Boxes {
-        /// Depth below the root (0 = the root's box).
+        /// Depth below each structure's root (0 = the root's box), as [`crate::accel::AccelStats`] counts it.
         depth: usize,
     },
     /// Traversal cost per pixel in false colour.
@@ -155,13 +157,14 @@ pub fn legend_rows(height: u32) -> u32 {
     (height / 16).clamp(1, 24).min(height)
 }
 
-/// Maps a film of raw costs (red channel) to false colour normalised by its maximum, and draws the
-/// legend bar over the bottom [`legend_rows`] rows (left = no work, right = the maximum). Returns the
-/// maximum cost.
-pub fn heatmap_finish(film: &mut Film) -> u32 {
+/// Maps a film of raw costs (red channel) to false colour normalised by `scale`, else by its maximum,
+/// and draws the legend bar over the bottom [`legend_rows`] rows (left = no work, right = the scale).
+/// Returns the maximum cost.
+pub fn heatmap_finish(film: &mut Film, scale: Option<u32>) -> u32 {
     let max = film.pixels.iter().map(|c| c.x).fold(0.0f32, f32::max);
+    let top = scale.map_or(max, |s| s as f32);
     for c in &mut film.pixels {
-        *c = false_color(if max > 0.0 { c.x / max } else { 0.0 });
+        *c = false_color(if top > 0.0 { (c.x / top).min(1.0) } else { 0.0 });
     }
     let (w, h) = (film.width, film.height);
     for y in h - legend_rows(h)..h {

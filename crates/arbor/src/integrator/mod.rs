@@ -4,6 +4,7 @@ pub mod debug;
 mod hemisphere;
 pub mod offset;
 mod path;
+mod prune;
 mod ray_log;
 mod roulette;
 mod whitted;
@@ -11,7 +12,8 @@ mod whitted;
 pub use debug::{DebugIntegrator, DebugView};
 pub use hemisphere::{cosine_hemisphere, uniform_hemisphere};
 pub use path::PathTracer;
-pub use ray_log::{RayLog, TIMED_EVERY};
+pub use prune::{Pruning, TreePlan, PRUNED_LEVELS, TREE_BUDGET};
+pub use ray_log::{thread_time, RayEvent, RayLog, TIMED_EVERY};
 pub use roulette::MAX_BOUNCES;
 pub use whitted::Whitted;
 

@@ -22,6 +22,7 @@
 //! lights their [`crate::light::Light::sample`], never the description.
 
 use super::offset::{shadow_ray, spawn_origin};
+use super::prune::{Pruning, Shares, TreePlan, TREE_BUDGET};
 use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::{Camera, RayCone};
@@ -37,6 +38,8 @@ pub struct Whitted<'a> {
     camera: Option<&'a Camera>,
     /// The camera's pixel cone (zero without a camera: the finest texture level).
     cone: RayCone,
+    /// How trees too large for the budget are cut ([`super::prune`]); `None` for trees within it.
+    pruning: Option<Pruning>,
 }
 
 /// What a ray carries down the recursion.
@@ -48,12 +51,23 @@ struct Carried {
     inside: Option<Color>,
     /// The pixel's cone, as wide as it is where the ray starts.
     cone: RayCone,
+    /// The product of the lobe weights above the ray, largest channel (for pruning).
+    weight: f32,
+    /// The rays the ray's tree may trace, itself included ([`super::prune`]; infinite without a budget).
+    allowance: f32,
 }
 
 impl<'a> Whitted<'a> {
     /// An integrator over `scene`; `cull_backfaces` applies to camera rays only.
     pub fn new(scene: &'a Scene, cull_backfaces: bool) -> Self {
-        Whitted { scene, cull_backfaces, camera: None, cone: RayCone::default() }
+        let pruning = TreePlan::of(scene).pruning;
+        Whitted { scene, cull_backfaces, camera: None, cone: RayCone::default(), pruning }
+    }
+
+    /// The same integrator tracing every tree whole, pruned or not, whatever it costs: the exact answer
+    /// that pruning is checked against.
+    pub fn exact(self) -> Self {
+        Whitted { pruning: None, ..self }
     }
 
     /// The integrator for the camera rays of `camera`, which a background texture spans.
@@ -63,7 +77,9 @@ impl<'a> Whitted<'a> {
 
     /// Radiance (in the scene's units) along a camera ray.
     pub fn li_camera(&self, ray: &Ray, rng: &mut Rng, log: &mut RayLog) -> Color {
-        self.li(&self.camera_ray(ray), self.camera_carried(), rng, log)
+        let ray = self.camera_ray(ray);
+        let hit = log.intersect(&self.scene.geometry, &ray, f32::INFINITY);
+        self.li_camera_hit(&ray, hit, rng, log)
     }
 
     /// The camera ray as it is traced: culling back faces if the render asks for it.
@@ -76,23 +92,59 @@ impl<'a> Whitted<'a> {
     /// closest hit.
     pub fn li_camera_hit(&self, ray: &Ray, hit: Option<Hit>, rng: &mut Rng, log: &mut RayLog) -> Color {
         log.rays += 1;
-        self.shade(ray, hit, self.camera_carried(), rng, log)
+        if self.pruning.is_none() {
+            return self.shade(ray, hit, self.camera_carried(f32::INFINITY), rng, log);
+        }
+        // The whole (pruned) tree while it stays within the budget; a tree that needs more is traced
+        // again from the same random numbers, with the budget shared out by weight.
+        let start = rng.clone();
+        (log.tree, log.capped) = (1, false);
+        let c = self.shade(ray, hit, self.camera_carried(f32::INFINITY), rng, log);
+        if !log.capped {
+            return c;
+        }
+        *rng = start;
+        (log.tree, log.capped) = (1, false);
+        let c = self.shade(ray, hit, self.camera_carried(TREE_BUDGET as f32), rng, log);
+        log.capped_samples += u64::from(log.capped);
+        c
     }
 
-    fn camera_carried(&self) -> Carried {
-        Carried { depth: 0, inside: None, cone: self.cone }
+    fn camera_carried(&self, allowance: f32) -> Carried {
+        Carried { depth: 0, inside: None, cone: self.cone, weight: 1.0, allowance }
+    }
+
+    /// The allowance of the ray of a lobe of weight `w` from a hit at `depth` whose own weight is
+    /// `weight`, or `None` when it is not traced: pruned (it cannot change the image), or given less
+    /// than one ray of the budget `shares` hands out.
+    #[inline]
+    fn allowance(&self, weight: f32, w: f32, depth: u32, shares: &mut Shares, log: &mut RayLog) -> Option<f32> {
+        let Some(p) = &self.pruning else { return Some(f32::INFINITY) };
+        if p.prunes(weight * w, self.scene.max_depth - depth - 1) {
+            shares.skip(w);
+            return None;
+        }
+        if shares.unlimited() {
+            // The first pass: the whole tree, until it is found to need more than the budget.
+            log.capped |= log.tree >= TREE_BUDGET;
+            return (!log.capped).then_some(f32::INFINITY);
+        }
+        let share = shares.take(w);
+        log.capped |= share.is_none();
+        share
     }
 
     /// Radiance along `ray`.
     fn li(&self, ray: &Ray, carried: Carried, rng: &mut Rng, log: &mut RayLog) -> Color {
         log.rays += 1;
+        log.tree += 1;
         let hit = log.intersect(&self.scene.geometry, ray, f32::INFINITY);
         self.shade(ray, hit, carried, rng, log)
     }
 
     /// Radiance along `ray` given its closest hit.
     fn shade(&self, ray: &Ray, hit: Option<Hit>, carried: Carried, rng: &mut Rng, log: &mut RayLog) -> Color {
-        let Carried { depth, inside, cone } = carried;
+        let Carried { depth, inside, cone, weight, allowance } = carried;
         let scene = self.scene;
         let Some(hit) = hit else {
             return self.miss(ray, depth);
@@ -146,10 +198,14 @@ impl<'a> Whitted<'a> {
             // Lobes see the shading normal unless it disagrees with the geometric one about which side
             // the ray comes from (possible at silhouettes of smooth meshes).
             let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
-            for lobe in m.specular_lobes(d, n) {
+            let lobes = m.specular_lobes(d, n);
+            let mut shares = Shares::new(allowance, &lobes);
+            for lobe in lobes {
                 if lobe.weight == Color::ZERO {
                     continue;
                 }
+                let w = lobe.weight.max_element();
+                let Some(allowance) = self.allowance(weight, w, depth, &mut shares, log) else { continue };
                 let dir = if m.roughness > 0.0 { perturb(lobe.dir, m.roughness, rng.next_2d()) } else { lobe.dir };
                 // Glass's lobes leave on the side they go to (into or out of it). A mirror's leave on
                 // the side the surface shows, like its shadow rays: the METU renderers offset them
@@ -158,8 +214,16 @@ impl<'a> Whitted<'a> {
                 let side = if m.transmits() || scene.flip_back_faces { dir } else { ng };
                 let origin = spawn_origin(scene.offset, &s, side);
                 let next_inside = m.medium_after(&lobe, front, inside);
-                let next = Carried { depth: depth + 1, inside: next_inside, cone: cone.after(hit.t * d.length()) };
+                let next = Carried {
+                    depth: depth + 1,
+                    inside: next_inside,
+                    cone: cone.after(hit.t * d.length()),
+                    weight: weight * w,
+                    allowance,
+                };
+                let before = log.tree;
                 let l = self.li(&Ray::new(origin, dir).with_time(ray.time), next, rng, log);
+                shares.spent(log.tree - before);
                 color += lobe.weight * l;
             }
         }

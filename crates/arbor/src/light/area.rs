@@ -28,6 +28,13 @@ impl Light for AreaLight {
         sample_area(position, normal, size, radiance, p, u)
     }
 
+    /// `L A / d²` with `d` the clearance of the square's centre less its half diagonal: no point of the
+    /// square is nearer any surface.
+    fn irradiance_bound(&self, clearance: &dyn Fn(Vec3) -> f32) -> Option<f32> {
+        let d = clearance(self.position) - self.size * std::f32::consts::FRAC_1_SQRT_2;
+        super::point::inverse_square(self.radiance.max_element() * self.size * self.size, d)
+    }
+
     fn power(&self) -> f32 {
         std::f32::consts::PI * luminance(self.radiance) * self.size * self.size
     }

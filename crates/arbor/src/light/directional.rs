@@ -23,6 +23,10 @@ impl Light for DirectionalLight {
         Some(LightSample { wi, dist: f32::INFINITY, irradiance: self.radiance, pdf: 0.0 })
     }
 
+    fn irradiance_bound(&self, _clearance: &dyn Fn(Vec3) -> f32) -> Option<f32> {
+        Some(self.radiance.max_element())
+    }
+
     fn power(&self) -> f32 {
         std::f32::consts::PI * self.scene_radius * self.scene_radius * luminance(self.radiance)
     }

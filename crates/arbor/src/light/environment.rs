@@ -1,9 +1,10 @@
 //! The environment map: the radiance arriving from infinitely far away along a direction, seen by every
 //! ray that leaves the scene. Either one latitude-longitude image or a cube map of six square faces.
 //!
-//! Values are in display units, exactly what [`read_image`] gives (8-bit files divided by 255, EXR and HDR
-//! as stored); lookups are bilinear. [`EnvMap::eval`] takes any non-zero finite direction, unit or not, and
-//! returns black for a zero, infinite or NaN one.
+//! Values are in display units, exactly what [`read_image_within`] gives (8-bit files divided by 255, EXR
+//! and HDR as stored), and finite: a file holding a NaN or an infinity is refused. Lookups are bilinear.
+//! [`EnvMap::eval`] takes any non-zero finite direction, unit or not, and returns black for a zero,
+//! infinite or NaN one.
 //!
 //! # Latitude-longitude (equirectangular) maps
 //! World +y is up. For the unit direction `d`:
@@ -46,10 +47,11 @@
 
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::error::{Error, Location, Result};
 use crate::film::Film;
-use crate::image_io::read_image;
+use crate::image_io::{check_finite, read_image_within, ImageLimits};
 use crate::math::{Color, Vec3};
 
 /// Face labels in storage order, the order of [`EnvMap::from_faces`].
@@ -69,9 +71,10 @@ const FACE_NAMES: [[&str; 3]; 6] = [
 const IMAGE_EXTENSIONS: [&str; 9] = ["png", "jpg", "jpeg", "ppm", "pgm", "pnm", "exr", "hdr", "pfm"];
 
 /// Radiance from infinitely far away, by direction. See the module documentation for the conventions.
+/// Clones share the images.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvMap {
-    kind: Kind,
+    kind: Arc<Kind>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -83,18 +86,22 @@ enum Kind {
 
 impl EnvMap {
     /// Loads a map: an image file is a latitude-longitude map, a directory a cube map whose faces are
-    /// found by name. Errors name the file, or list the faces a directory lacks.
-    pub fn load(spec: &Path) -> Result<EnvMap> {
+    /// found by name. Each image is held to `limits` and must hold finite values. Errors name the file,
+    /// or list the faces a directory lacks.
+    pub fn load(spec: &Path, limits: &ImageLimits) -> Result<EnvMap> {
         if spec.is_dir() {
             let paths = find_faces(spec)?;
-            let [a, b, c, d, e, f] = paths.each_ref().map(|p| read_image(p));
-            let faces = [a?, b?, c?, d?, e?, f?];
+            let mut faces = Vec::with_capacity(6);
+            for path in &paths {
+                faces.push(read_map(path, limits)?);
+            }
+            let faces: [Film; 6] = faces.try_into().expect("six faces");
             if let Err((face, msg)) = check_faces(&faces) {
                 return Err(Error::input(Location::file(&paths[face]), msg));
             }
             return Ok(cube(faces));
         }
-        let film = read_image(spec)?;
+        let film = read_map(spec, limits)?;
         if film.pixels.is_empty() {
             return Err(Error::input(Location::file(spec), "the environment map is empty"));
         }
@@ -110,16 +117,16 @@ impl EnvMap {
             film.width > 0 && film.pixels.len() == film.width as usize * film.height as usize,
             "latitude-longitude film must be non-empty and consistent"
         );
-        EnvMap { kind: Kind::LatLong(film) }
+        EnvMap { kind: Arc::new(Kind::LatLong(film)) }
     }
 
-    /// A light probe (angular map) from a file: see the module documentation.
-    pub fn load_probe(path: &Path) -> Result<EnvMap> {
-        let film = read_image(path)?;
+    /// A light probe (angular map) from a file (see the module documentation), held to `limits`.
+    pub fn load_probe(path: &Path, limits: &ImageLimits) -> Result<EnvMap> {
+        let film = read_map(path, limits)?;
         if film.pixels.is_empty() {
             return Err(Error::input(Location::file(path), "the environment map is empty"));
         }
-        Ok(EnvMap { kind: Kind::Probe(film) })
+        Ok(EnvMap { kind: Arc::new(Kind::Probe(film)) })
     }
 
     /// A light probe (angular map) from an image in memory.
@@ -131,7 +138,7 @@ impl EnvMap {
             film.width > 0 && film.pixels.len() == film.width as usize * film.height as usize,
             "light probe film must be non-empty and consistent"
         );
-        EnvMap { kind: Kind::Probe(film) }
+        EnvMap { kind: Arc::new(Kind::Probe(film)) }
     }
 
     /// A cube map from six faces in the order `+x -x +y -y +z -z` ([`FACE_LABELS`]). The faces must be
@@ -143,7 +150,7 @@ impl EnvMap {
 
     /// The image of a latitude-longitude map; `None` for the other forms.
     pub fn latlong(&self) -> Option<&Film> {
-        match &self.kind {
+        match &*self.kind {
             Kind::LatLong(film) => Some(film),
             _ => None,
         }
@@ -151,7 +158,7 @@ impl EnvMap {
 
     /// True for a cube map, false for a latitude-longitude map.
     pub fn is_cube_map(&self) -> bool {
-        matches!(self.kind, Kind::Cube { .. })
+        matches!(*self.kind, Kind::Cube { .. })
     }
 
     /// The radiance arriving along `-dir`, i.e. seen when looking in direction `dir` (need not be unit).
@@ -159,7 +166,7 @@ impl EnvMap {
         if !dir.is_finite() || dir == Vec3::ZERO {
             return Color::ZERO;
         }
-        match &self.kind {
+        match &*self.kind {
             Kind::LatLong(film) => eval_latlong(film, dir),
             Kind::Probe(film) => eval_probe(film, dir),
             Kind::Cube { size, faces } => eval_cube(faces, *size, dir),
@@ -168,7 +175,15 @@ impl EnvMap {
 }
 
 fn cube(faces: [Film; 6]) -> EnvMap {
-    EnvMap { kind: Kind::Cube { size: faces[0].width, faces: Box::new(faces) } }
+    EnvMap { kind: Arc::new(Kind::Cube { size: faces[0].width, faces: Box::new(faces) }) }
+}
+
+/// An image of a map: radiance, so a NaN or an infinity (which a float file can hold) is refused; it
+/// would reach every pixel whose rays see it, and the estimates of every point it lights.
+fn read_map(path: &Path, limits: &ImageLimits) -> Result<Film> {
+    let film = read_image_within(path, limits)?;
+    check_finite(film.pixels.iter().map(|c| c.to_array()), film.width, path)?;
+    Ok(film)
 }
 
 /// The first face that is not square, empty, inconsistent or of another size than face 0.

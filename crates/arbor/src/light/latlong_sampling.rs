@@ -6,13 +6,15 @@
 //! A pixel's weight is the largest luminance among it and its eight neighbours: lookups are bilinear, so
 //! a direction in a black pixel next to a bright one still sees light, and must have a non-zero density
 //! for the estimate to stay unbiased. Within a pixel `(u, v)` is uniform, so the density per solid angle
-//! is `p(pixel) · W · H / (2π² sin θ)` with the exact `θ` of the direction.
+//! is `p(pixel) · W · H / (2π² sin θ)` with the exact `θ` of the direction. The tables take 8 bytes
+//! per pixel, allocated fallibly.
 
 use std::f32::consts::PI;
 
 use crate::film::Film;
 use crate::math::{Vec2, Vec3};
 use crate::tonemap::luminance;
+use crate::{Error, Result};
 
 /// The distribution over a map's pixels.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,19 +28,25 @@ pub struct LatLongSampler {
 }
 
 impl LatLongSampler {
-    /// The distribution for `film`; `None` when the map is black (nothing to sample) or empty.
-    pub fn new(film: &Film) -> Option<Self> {
+    /// The distribution for `film`; `None` when the map is black (nothing to sample) or empty;
+    /// [`Error::OutOfMemory`] when its tables cannot be allocated.
+    pub fn new(film: &Film) -> Result<Option<Self>> {
         let (width, height) = (film.width as usize, film.height as usize);
         if width == 0 || height == 0 {
-            return None;
+            return Ok(None);
         }
         let lum = |i: isize, j: isize| {
             let x = i.rem_euclid(width as isize) as u32;
             let y = j.clamp(0, height as isize - 1) as u32;
             luminance(film.get(x, y)).max(0.0) as f64
         };
-        let mut cols = Vec::with_capacity(height * (width + 1));
-        let mut rows = vec![0.0];
+        let (mut cols, mut rows) = (Vec::new(), Vec::new());
+        let n = height.saturating_mul(width + 1);
+        if cols.try_reserve_exact(n).is_err() || rows.try_reserve_exact(height + 1).is_err() {
+            let gib = (n as f64 + height as f64) * 8.0 / (1u64 << 30) as f64;
+            return Err(Error::OutOfMemory(format!("not enough memory for its sampling table ({gib:.1} GiB)")));
+        }
+        rows.push(0.0);
         for j in 0..height {
             let sin = (PI * (j as f32 + 0.5) / height as f32).sin() as f64;
             let mut acc = 0.0;
@@ -52,7 +60,7 @@ impl LatLongSampler {
             rows.push(rows[j] + acc);
         }
         let total = rows[height];
-        (total > 0.0 && total.is_finite()).then_some(LatLongSampler { width, height, rows, cols })
+        Ok((total > 0.0 && total.is_finite()).then_some(LatLongSampler { width, height, rows, cols }))
     }
 
     /// A unit direction for `u` in `[0,1)²` and its density per unit solid angle; `None` at a pole.
@@ -113,7 +121,7 @@ mod tests {
     #[test]
     fn latlong_pdf_matches_the_density_of_the_sample() {
         let pixels = (0..32 * 16).map(|k| Color::splat(1.0 + (k % 7) as f32 * (k % 5) as f32)).collect();
-        let s = LatLongSampler::new(&Film { width: 32, height: 16, pixels }).unwrap();
+        let s = LatLongSampler::new(&Film { width: 32, height: 16, pixels }).unwrap().unwrap();
         for k in 0..50 {
             let u = Vec2::new((k % 10) as f32 / 10.0 + 0.037, (k / 10) as f32 / 5.0 + 0.051);
             let (d, pdf) = s.sample(u).unwrap();
@@ -124,7 +132,7 @@ mod tests {
     #[test]
     fn latlong_sampling_of_a_uniform_map_is_close_to_uniform_on_the_sphere() {
         let film = Film { width: 64, height: 32, pixels: vec![Color::ONE; 64 * 32] };
-        let s = LatLongSampler::new(&film).unwrap();
+        let s = LatLongSampler::new(&film).unwrap().unwrap();
         for k in 0..100 {
             let u = Vec2::new((k % 10) as f32 / 10.0 + 0.03, (k / 10) as f32 / 10.0 + 0.05);
             let (d, pdf) = s.sample(u).unwrap();
@@ -135,14 +143,14 @@ mod tests {
                 assert!((pdf * 4.0 * PI - 1.0).abs() < 0.05, "{pdf} at {d}");
             }
         }
-        assert!(LatLongSampler::new(&Film { width: 2, height: 1, pixels: vec![Color::ZERO; 2] }).is_none());
+        assert!(LatLongSampler::new(&Film { width: 2, height: 1, pixels: vec![Color::ZERO; 2] }).unwrap().is_none());
     }
 
     #[test]
     fn latlong_sampling_lands_around_the_light() {
         let mut film = Film { width: 32, height: 16, pixels: vec![Color::ZERO; 32 * 16] };
         film.pixels[5 * 32 + 20] = Color::splat(100.0);
-        let s = LatLongSampler::new(&film).unwrap();
+        let s = LatLongSampler::new(&film).unwrap().unwrap();
         let map = EnvMap::from_film_latlong(film);
         let mut lit = 0;
         for k in 0..64 {
@@ -167,7 +175,7 @@ mod tests {
             .map(|k| if (k / w, k % w) == (10, 40) { Color::splat(500.0) } else { Color::splat(0.2) })
             .collect();
         let film = Film { width: w, height: h, pixels };
-        let s = LatLongSampler::new(&film).unwrap();
+        let s = LatLongSampler::new(&film).unwrap().unwrap();
         let map = EnvMap::from_film_latlong(film);
         let n = Vec3::Y;
         let k = 256;

@@ -70,6 +70,13 @@ pub trait Light: fmt::Debug + Send + Sync {
         None
     }
 
+    /// An upper bound on every channel of [`Light::sample`]'s irradiance at any point of the scene,
+    /// given `clearance(q)`, a lower bound on the distance from `q` to any surface; `None` when there is
+    /// none (a light that surfaces may touch, or whose bound is not worked out).
+    fn irradiance_bound(&self, _clearance: &dyn Fn(Vec3) -> f32) -> Option<f32> {
+        None
+    }
+
     /// Whether the light is a point or a direction, whose [`Light::sample`] does not read `u`.
     fn is_delta(&self) -> bool {
         false

@@ -14,6 +14,12 @@ pub struct PointLight {
     pub intensity: Color,
 }
 
+/// `intensity / d²`, or `None` when `d` is not positive (a surface touches the light).
+pub(super) fn inverse_square(intensity: f32, d: f32) -> Option<f32> {
+    let bound = intensity / (d * d);
+    (d > 0.0 && bound.is_finite()).then_some(bound)
+}
+
 impl Light for PointLight {
     fn sample(&self, p: Vec3, _n: Vec3, _u: Vec2) -> Option<LightSample> {
         let to_light = self.position - p;
@@ -29,6 +35,11 @@ impl Light for PointLight {
 
     fn power(&self) -> f32 {
         4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    /// `I / d²` at the nearest surface.
+    fn irradiance_bound(&self, clearance: &dyn Fn(Vec3) -> f32) -> Option<f32> {
+        inverse_square(self.intensity.max_element(), clearance(self.position))
     }
 
     fn is_delta(&self) -> bool {

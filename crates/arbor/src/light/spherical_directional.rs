@@ -18,6 +18,7 @@ use super::latlong_sampling::LatLongSampler;
 use super::{Light, LightSample};
 use crate::math::{orthonormal_basis, Vec2, Vec3};
 use crate::tonemap::luminance;
+use crate::Result;
 
 /// The environment map as a light.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,11 +34,15 @@ pub struct SphericalDirectionalLight {
 impl SphericalDirectionalLight {
     /// The light of `map` (radiance in display units, as [`EnvMap::eval`] gives it); `units` is the
     /// scene's radiance per display unit (the inverse of its radiance scale), so that the light agrees
-    /// with what camera rays that miss see.
-    pub fn new(map: EnvMap, units: f32) -> Self {
-        let sampler = map.latlong().and_then(LatLongSampler::new);
+    /// with what camera rays that miss see. [`crate::Error::OutOfMemory`] when a lat-long map's sampling
+    /// table cannot be allocated.
+    pub fn new(map: EnvMap, units: f32) -> Result<Self> {
+        let sampler = match map.latlong() {
+            Some(film) => LatLongSampler::new(film)?,
+            None => None,
+        };
         let mean = mean_luminance(&map) * units;
-        SphericalDirectionalLight { map, units, sampler, mean, scene_radius: 1.0 }
+        Ok(SphericalDirectionalLight { map, units, sampler, mean, scene_radius: 1.0 })
     }
 
     /// The light with the radius of the scene's bounding sphere, for [`Light::power`].
@@ -116,7 +121,7 @@ mod tests {
 
     fn uniform(c: Color) -> SphericalDirectionalLight {
         let film = Film { width: 4, height: 2, pixels: vec![c; 8] };
-        SphericalDirectionalLight::new(EnvMap::from_film_latlong(film), 255.0).without_importance()
+        SphericalDirectionalLight::new(EnvMap::from_film_latlong(film), 255.0).unwrap().without_importance()
     }
 
     #[test]
@@ -139,7 +144,7 @@ mod tests {
         // mean of the estimates times the cosine, over a stratified grid, sampling uniformly or by
         // the map's luminance.
         let film = Film { width: 64, height: 32, pixels: vec![Color::ONE; 64 * 32] };
-        let importance = SphericalDirectionalLight::new(EnvMap::from_film_latlong(film), 255.0);
+        let importance = SphericalDirectionalLight::new(EnvMap::from_film_latlong(film), 255.0).unwrap();
         assert!(importance.sampler.is_some());
         for light in [uniform(Color::ONE), importance] {
             for n in [Vec3::Y, Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize()] {

@@ -61,6 +61,11 @@ impl Light for SpotLight {
         (s > 0.0).then(|| LightSample { irradiance: ls.irradiance * s, ..ls })
     }
 
+    /// A point light's: the fall-off only dims it.
+    fn irradiance_bound(&self, clearance: &dyn Fn(Vec3) -> f32) -> Option<f32> {
+        super::point::inverse_square(self.intensity.max_element(), clearance(self.position))
+    }
+
     fn power(&self) -> f32 {
         let cone = 1.0 - 0.5 * (self.cos_falloff + self.cos_coverage);
         std::f32::consts::TAU * luminance(self.intensity) * cone

@@ -34,6 +34,10 @@ impl SpecularLayer for Conductor {
         let fr = fresnel_conductor(cos_i.abs(), self.eta, self.k);
         vec![Lobe { dir: reflect(d, n).normalize(), weight: self.reflectance * fr, transmitted: false }]
     }
+    /// Fresnel reflectance is at most 1.
+    fn weight_bound(&self) -> f32 {
+        self.reflectance.max_element()
+    }
 }
 
 #[cfg(test)]

@@ -43,6 +43,13 @@ impl SpecularLayer for Dielectric {
     fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe> {
         lobes(self.eta, Color::ONE, d, n)
     }
+    fn max_lobes(&self) -> usize {
+        2
+    }
+    /// `F + (1 - F)`: what is not reflected is refracted.
+    fn weight_bound(&self) -> f32 {
+        1.0
+    }
     fn transmits(&self) -> bool {
         true
     }

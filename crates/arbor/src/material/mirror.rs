@@ -21,6 +21,9 @@ impl SpecularLayer for Mirror {
     fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe> {
         vec![self.lobe(d, n)]
     }
+    fn weight_bound(&self) -> f32 {
+        self.reflectance.max_element()
+    }
 }
 
 #[cfg(test)]

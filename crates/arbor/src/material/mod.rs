@@ -45,6 +45,14 @@ pub trait SpecularLayer: fmt::Debug + Send + Sync {
     /// normal faces is "outside" for refraction).
     fn lobes(&self, d: Vec3, n: Vec3) -> Vec<Lobe>;
 
+    /// The most lobes [`SpecularLayer::lobes`] gives (rays a hit spawns).
+    fn max_lobes(&self) -> usize {
+        1
+    }
+
+    /// An upper bound on the sum of the lobes' weights in any channel, over every `d` and `n`.
+    fn weight_bound(&self) -> f32;
+
     /// Whether light crosses the surface. Such a surface hit from inside only refracts and reflects: its
     /// ambient and Blinn-Phong terms belong to its outside.
     fn transmits(&self) -> bool {

@@ -28,6 +28,13 @@ impl SpecularLayer for Transparent {
     fn transmits(&self) -> bool {
         true
     }
+    fn max_lobes(&self) -> usize {
+        3
+    }
+    /// `F + (1 - F) t` is at most `max(1, t)`, plus the mirror lobe.
+    fn weight_bound(&self) -> f32 {
+        self.transparency.max_element().max(1.0) + self.mirror.max_element()
+    }
 }
 
 #[cfg(test)]

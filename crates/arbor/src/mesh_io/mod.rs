@@ -55,13 +55,7 @@ pub fn load_mesh(path: &Path) -> Result<TriangleMesh> {
 /// ran out (the CLI's exit 4) instead of an abort: headers are checked against the file's size, but a
 /// large file can still claim more than the machine has.
 pub(crate) fn vec_for<T>(n: u64, what: &str, path: &Path) -> Result<Vec<T>> {
-    let mut v = Vec::new();
-    if usize::try_from(n).ok().and_then(|n| v.try_reserve_exact(n).ok()).is_none() {
-        let gib = n as f64 * std::mem::size_of::<T>() as f64 / (1u64 << 30) as f64;
-        let msg = format!("not enough memory for {n} {what} ({gib:.1} GiB)");
-        return Err(Error::io(path, std::io::Error::new(std::io::ErrorKind::OutOfMemory, msg)));
-    }
-    Ok(v)
+    crate::input::vec_for(n, path, |gib| format!("not enough memory for {n} {what} ({gib:.1} GiB)"))
 }
 
 /// Lines of a text file as `(1-based line number, bytes without "\n" or "\r\n")`.

@@ -23,6 +23,7 @@ use super::runtime::{RayOffset, Scene};
 use crate::accel::{AccelConfig, Primitives};
 use crate::camera::{Camera, ImagePlane, Projection};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
+use crate::image_io::ImageLimits;
 use crate::light::environment::EnvMap;
 use crate::light::{AreaLight, DirectionalLight, Light, PointLight, SphericalDirectionalLight, SpotLight};
 use crate::material::{Brdf, BrdfModel, Conductor, Dielectric, Material, Mirror, SpecularLayer, Transparent, DEGAMMA};
@@ -37,14 +38,26 @@ impl Scene {
     /// Loads the assets of `desc` and builds its runtime scene, with the structure `spec` describes at
     /// both levels. `environment` overrides the scene's own map. A map the scene names
     /// (`SphericalDirectionalLight`) also lights it; one given only by `environment` is background only.
+    /// The images the scene reads are held to the default budget, [`ImageLimits::DEFAULT`].
     pub fn build(desc: SceneDesc, spec: &AccelConfig, environment: Option<EnvMap>) -> Result<Scene> {
+        Scene::build_within(desc, spec, environment, &ImageLimits::DEFAULT)
+    }
+
+    /// [`Scene::build`] with every image the scene reads (textures, its environment map or cube faces)
+    /// held to `images`.
+    pub fn build_within(
+        desc: SceneDesc,
+        spec: &AccelConfig,
+        environment: Option<EnvMap>,
+        images: &ImageLimits,
+    ) -> Result<Scene> {
         let environment = match environment {
             Some(env) => Some(env),
-            None => load_environment(&desc)?,
+            None => load_environment(&desc, images)?,
         };
         let start = Instant::now();
         let geometry = build_geometry(&desc, spec)?;
-        let textures = textures::build_textures(&desc)?;
+        let textures = textures::build_textures(&desc, images)?;
         let build_time = start.elapsed().saturating_sub(geometry.counts.mesh_load);
         // The radius of the bounded objects' bounding sphere, for the power of lights at infinity.
         let bounds = geometry.top.bounds();
@@ -54,7 +67,8 @@ impl Scene {
         if let (Some(map), true) = (&environment, desc.environment.is_some()) {
             let units = 1.0 / desc.radiance_scale;
             environment_light = Some(lights.len());
-            lights.push(Box::new(SphericalDirectionalLight::new(map.clone(), units).with_scene_radius(radius)));
+            let light = SphericalDirectionalLight::new(map.clone(), units).map_err(|e| environment_error(&desc, e))?;
+            lights.push(Box::new(light.with_scene_radius(radius)));
         }
         let (object_lights, object_emission) = emitters::build_emitters(&desc, &geometry, &mut lights)?;
         let offset = match desc.offset {
@@ -97,22 +111,28 @@ impl Scene {
     }
 }
 
-/// The environment map the scene names, if any. A map that cannot be read is the scene's fault, like a
-/// missing mesh: located where the file names it.
-fn load_environment(desc: &SceneDesc) -> Result<Option<EnvMap>> {
+/// The environment map the scene names, if any, its images held to `images`. A map that cannot be read
+/// (or is above the budget, or does not fit in memory) is the scene's fault, like a missing mesh:
+/// located where the file names it.
+fn load_environment(desc: &SceneDesc, images: &ImageLimits) -> Result<Option<EnvMap>> {
     let Some(path) = desc.environment.as_deref() else { return Ok(None) };
-    let map = if desc.environment_probe { EnvMap::load_probe(path) } else { EnvMap::load(path) };
-    map.map(Some).map_err(|e| {
-        let why = match e {
-            Error::Io { source, .. } => source.to_string(),
-            // An undecodable map file; a face of a cube-map folder keeps its own name in the message.
-            Error::Input { loc, msg } if loc.file == path => msg,
-            e @ Error::Input { .. } => e.to_string(),
-            other => return other,
-        };
-        let loc = desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source));
-        Error::input(loc, format!("cannot read environment map '{}': {why}", path.display()))
-    })
+    let map = if desc.environment_probe { EnvMap::load_probe(path, images) } else { EnvMap::load(path, images) };
+    map.map(Some).map_err(|e| environment_error(desc, e))
+}
+
+/// An error of the scene's environment map `desc.environment`, at the element that names it.
+fn environment_error(desc: &SceneDesc, e: Error) -> Error {
+    let Some(path) = desc.environment.as_deref() else { return e };
+    let why = match e {
+        Error::Io { source, .. } => source.to_string(),
+        // An undecodable map file; a face of a cube-map folder keeps its own name in the message.
+        Error::Input { loc, msg } if loc.file == path => msg,
+        e @ Error::Input { .. } => e.to_string(),
+        Error::OutOfMemory(msg) => msg,
+        other => return other,
+    };
+    let loc = desc.environment_loc.clone().unwrap_or_else(|| Location::file(&desc.source));
+    Error::input(loc, format!("cannot read environment map '{}': {why}", path.display()))
 }
 
 /// The runtime camera of a description: its transform applied to position, gaze and up.
@@ -208,6 +228,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     let start = Instant::now();
     let files = load_mesh_files(desc)?;
     let mesh_load = start.elapsed();
+    let build_start = Instant::now();
 
     // One shape per mesh object, built in parallel; instances point at their base's.
     let mesh_objects: Vec<usize> =
@@ -257,7 +278,13 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
             Shape::Sphere(s) => s.bounds(),
         };
         // A translation sweeps the box between its two ends; their union holds every box in between.
-        let bounds = bounds.union(Aabb::new(bounds.min + object.motion, bounds.max + object.motion));
+        let swept = bounds.union(Aabb::new(bounds.min + object.motion, bounds.max + object.motion));
+        if !finite_or_empty(&swept) {
+            let how = if finite_or_empty(&bounds) { "its bounds swept by its MotionBlur" } else { "its bounds" };
+            let msg = format!("{}: {how} overflow to infinity (beyond the range of 32-bit floats)", object.name);
+            return Err(Error::input(object.loc.clone(), msg));
+        }
+        let bounds = swept;
         match &shape {
             Shape::Mesh(m) => counts.triangles += m.mesh.len(),
             Shape::Sphere(_) => counts.spheres += 1,
@@ -278,6 +305,7 @@ pub fn build_geometry(desc: &SceneDesc, spec: &AccelConfig) -> Result<SceneGeome
     counts.planes = planes.len();
     counts.objects = objects.len();
     let top = top_level(spec).build_accel(&objects).map_err(|e| Error::Invalid(e.to_string()))?;
+    counts.build = build_start.elapsed();
     Ok(SceneGeometry { objects, top, meshes: shapes, planes, counts })
 }
 
@@ -297,6 +325,12 @@ fn top_level(spec: &AccelConfig) -> AccelConfig {
         _ => {}
     }
     top
+}
+
+/// True for a box of finite corners, or the empty box of an object without primitives: an infinite
+/// corner would make the top level's costs and every ray's slab distances infinite or NaN.
+fn finite_or_empty(b: &Aabb) -> bool {
+    b.is_empty() || (b.min.is_finite() && b.max.is_finite())
 }
 
 /// An object's motion over the shutter interval, `None` when it stands still.
@@ -394,6 +428,7 @@ mod tests {
             width: 800,
             height: 800,
             image_name: "x.png".into(),
+            name_loc: Location::file("x.xml"),
             num_samples: 4,
             transform: Transform::IDENTITY,
             lens: None,

@@ -46,7 +46,9 @@ pub struct SceneDesc {
     /// on the side of its stored normal (counter-clockwise winding, outward for spheres), so a back face
     /// is lit by the lights in front of it. NYU scenes turn them.
     pub flip_back_faces: bool,
-    /// The scene's own back-face culling choice for primary rays (`BackfaceCulling`), if it makes one.
+    /// Back-face culling of primary rays as the scene asks for it (`BackfaceCulling`) or its form implies
+    /// (the 2025 METU JSON form culls, the NYU form does not); `None` (METU XML) leaves it to the user:
+    /// no culling by default.
     pub cull_backfaces: Option<bool>,
     /// One image per camera.
     pub cameras: Vec<CameraDesc>,
@@ -161,6 +163,8 @@ pub struct CameraDesc {
     pub height: u32,
     /// Output file name, relative to the output folder; its extension picks the format.
     pub image_name: String,
+    /// Where the file gives `image_name` (the camera's own location when the format derives the name).
+    pub name_loc: Location,
     /// Samples per pixel (`NumSamples`), at least 1; the METU readers give a perfect square.
     pub num_samples: u32,
     /// Camera transform (applied to position, gaze and up).

@@ -18,9 +18,11 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::accel::{Accel, AccelStats, Hit, PrimHit, Primitives, TraversalCounts};
+use crate::accel::{Accel, Hit, PrimHit, Primitives, TraversalCounts};
 use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
+
+mod summary;
 
 /// Scenes of at most this many bounded objects trace batches object by object
 /// ([`SceneGeometry::intersect_many`]), every ray meeting every object's root ...
@@ -192,6 +194,10 @@ pub struct SceneCounts {
     pub objects: usize,
     /// Time spent reading mesh files.
     pub mesh_load: Duration,
+    /// Wall time from the loaded meshes to the finished structures: every mesh's (built in parallel,
+    /// with its vertex normals), the object list and the top level's. Not the sum of the structures'
+    /// own build times, which would count time once per thread that built in parallel.
+    pub build: Duration,
 }
 
 /// The geometry of a scene under its two-level acceleration structure.
@@ -329,53 +335,6 @@ impl SceneGeometry {
                 bounded + (hit.prim - self.objects.len() as u32)
             }
         }
-    }
-
-    /// The world-space boxes of the nodes at `depth` of the top-level structure and of every mesh's
-    /// structure (the boxes debug view).
-    pub fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
-        let mut out = self.top.boxes_at_depth(depth);
-        for o in &self.objects.objects {
-            if let Shape::Mesh(m) = &o.shape {
-                let boxes = m.accel.boxes_at_depth(depth);
-                out.extend(boxes.into_iter().map(|b| world_box(&b, o.transform.as_ref())));
-            }
-        }
-        out
-    }
-
-    /// Statistics of the structures together: the top level plus every distinct mesh's structure
-    /// (counts and bytes summed; depths through both levels; the SAH cost is the top level's plus each
-    /// mesh's weighted by the share of the scene's area its object covers, an estimate).
-    pub fn accel_stats(&self) -> AccelStats {
-        let top = self.top.stats();
-        let mut s = AccelStats { primitives: 0, ..top.clone() };
-        let (mut leaf_prims, mut depth_sum, mut refs) = (0.0, 0.0, 0.0);
-        let scene_area = self.bounds().area().max(f32::MIN_POSITIVE) as f64;
-        let mut mesh_max_depth = 0;
-        for m in &self.meshes {
-            let ms = m.accel.stats();
-            s.primitives += ms.primitives;
-            s.nodes += ms.nodes;
-            s.leaves += ms.leaves;
-            s.bytes += ms.bytes;
-            s.build_time += ms.build_time;
-            mesh_max_depth = mesh_max_depth.max(ms.max_depth);
-            leaf_prims += ms.mean_leaf_prims * ms.leaves as f64;
-            depth_sum += ms.mean_depth * ms.leaves as f64;
-            refs += ms.refs_per_prim * ms.primitives as f64;
-            s.sah_cost += ms.sah_cost * (m.accel.bounds().area() as f64 / scene_area).min(1.0);
-        }
-        s.primitives += self.counts.spheres;
-        refs += self.counts.spheres as f64;
-        s.max_depth = top.max_depth + mesh_max_depth;
-        let mesh_leaves = (s.leaves - top.leaves) as f64;
-        if mesh_leaves > 0.0 {
-            s.mean_leaf_prims = leaf_prims / mesh_leaves;
-            s.mean_depth = top.mean_depth + depth_sum / mesh_leaves;
-        }
-        s.refs_per_prim = if s.primitives > 0 { refs / s.primitives as f64 } else { 0.0 };
-        s
     }
 
     /// Whether anything moves over the shutter interval.

@@ -6,12 +6,16 @@
 //! depth 10) and below what a workstation cannot do: 2^28 pixels of film is 3 GiB of `f32` RGB, 2^34
 //! samples are hours of rendering. [`SceneLimits::none`] lifts them all (`arbor render --no-limits`).
 //! Every refusal names the limit, the value asked for and where the scene asks for it.
+//!
+//! The images a scene reads (textures, environment maps, cube faces) have their own budget,
+//! [`SceneLimits::images`], checked from each file's header when it is loaded ([`crate::image_io`]);
+//! images that `render` writes and `diff` or `merge` read back are held to the film's pixel limit
+//! instead ([`SceneLimits::rendered`]), so that whatever `render` may write can be compared and merged.
 
 use super::desc::SceneDesc;
+use crate::error::LIFT_LIMITS as LIFT;
+use crate::image_io::ImageLimits;
 use crate::{Error, Location, Result};
-
-/// How the user lifts the limits, for the messages.
-const LIFT: &str = "--no-limits lifts the limits";
 
 /// The largest images, sample counts, recursion depths and total work a scene may ask for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,11 +31,20 @@ pub struct SceneLimits {
     /// Largest number of camera samples (pixels x samples per pixel) of one image, and of all the
     /// scene's images together.
     pub max_work: u64,
+    /// The pixel budget of each image the scene reads (texture, environment map, cube face).
+    pub images: ImageLimits,
 }
 
 impl Default for SceneLimits {
     fn default() -> Self {
-        SceneLimits { max_side: 16384, max_pixels: 1 << 28, max_samples: 65536, max_depth: 64, max_work: 1 << 34 }
+        SceneLimits {
+            max_side: 16384,
+            max_pixels: 1 << 28,
+            max_samples: 65536,
+            max_depth: 64,
+            max_work: 1 << 34,
+            images: ImageLimits::DEFAULT,
+        }
     }
 }
 
@@ -44,7 +57,14 @@ impl SceneLimits {
             max_samples: u32::MAX,
             max_depth: u32::MAX,
             max_work: u64::MAX,
+            images: ImageLimits::NONE,
         }
+    }
+
+    /// The budget of an image `render` may write, for the images `diff` and `merge` read: the film's
+    /// pixel limit.
+    pub fn rendered(&self) -> ImageLimits {
+        ImageLimits { max_pixels: self.max_pixels }
     }
 }
 

@@ -2,10 +2,11 @@
 //! one [`SceneDesc`] (`desc.rs`: plain data with source positions; `limits.rs` bounds what it may ask
 //! for); the build step ([`Scene::build`], `build.rs`) loads its assets and turns it into a runtime
 //! [`Scene`]: geometry under acceleration structures (`geometry.rs`), materials, lights, cameras and
-//! the settings shading needs (`runtime.rs`). Nothing reads the description after the build. This file
+//! the settings shading needs (`runtime.rs`), and how far a point is from the geometry (`clearance.rs`). Nothing reads the description after the build. This file
 //! only re-exports.
 
 mod build;
+mod clearance;
 pub mod desc;
 mod geometry;
 mod limits;

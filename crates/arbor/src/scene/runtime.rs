@@ -63,7 +63,8 @@ pub struct Scene {
     /// Whether a surface hit from behind has its normals turned towards the ray; if not, it is shaded,
     /// and its shadow and mirror rays leave, on the side of its stored normal.
     pub flip_back_faces: bool,
-    /// The scene's own back-face culling choice for camera rays, if it makes one.
+    /// Back-face culling of camera rays as the scene (`BackfaceCulling`) or its form (the 2025 METU JSON
+    /// form culls) asks for it, if either makes a choice.
     pub cull_backfaces: Option<bool>,
     /// Where secondary rays start.
     pub offset: RayOffset,

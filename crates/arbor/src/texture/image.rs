@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use crate::image_io::{self, ImageLimits};
 use crate::math::{Color, Vec2};
 use crate::Result;
 
@@ -61,20 +62,22 @@ impl TexImage {
         }
     }
 
-    /// Reads PNG or JPEG as 8-bit texels, EXR and HDR as floats.
-    pub fn load(path: &Path) -> Result<TexImage> {
+    /// Reads PNG or JPEG as 8-bit texels, EXR and HDR as floats (which must be finite), within `limits`.
+    pub fn load(path: &Path, limits: &ImageLimits) -> Result<TexImage> {
         let hdr = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        if matches!(hdr.as_deref(), Some("exr" | "hdr")) {
-            let film = crate::image_io::read_image(path)?;
-            let texels = film.pixels.iter().flat_map(|c| c.to_array()).collect();
-            return Ok(TexImage::from_texels(film.width, film.height, Texels::F32(texels)));
-        }
-        let (w, h, bytes) = crate::image_io::read_rgb8(path)?;
+        let (w, h, texels) = if matches!(hdr.as_deref(), Some("exr" | "hdr")) {
+            let (w, h, texels) = image_io::read::<f32>(path, limits)?;
+            image_io::check_finite(texels.chunks_exact(3).map(|c| [c[0], c[1], c[2]]), w, path)?;
+            (w, h, Texels::F32(texels))
+        } else {
+            let (w, h, bytes) = image_io::read::<u8>(path, limits)?;
+            (w, h, Texels::U8(bytes))
+        };
         if w == 0 || h == 0 {
             let msg = "image has no texels".to_string();
             return Err(crate::Error::input(crate::Location::file(path), msg));
         }
-        Ok(TexImage::from_rgb8(w, h, bytes))
+        Ok(TexImage::from_texels(w, h, texels))
     }
 
     /// Whether texels are 8-bit.

@@ -2,7 +2,7 @@
 //! down to 1x1, in the image's own texel type (8-bit levels are rounded to the nearest byte). An odd
 //! side halves to its floor, its last texel joining the last box (3 wide), so every texel counts.
 //! Building costs one pass over a third of the image's texels; only images that a trilinear map samples
-//! get a mipmap.
+//! get a mipmap. Levels are allocated fallibly: no room for one is an error, never an abort.
 //!
 //! The level of detail of a footprint `w` wide in (u, v) units is `log2(w * sqrt(width * height))`, the
 //! side of the footprint in texels (Akenine-Möller et al. 2019, "Texture Level of Detail Strategies for
@@ -10,14 +10,16 @@
 
 use super::image::{TexImage, Texels};
 use crate::math::{Color, Vec2};
+use crate::{Error, Result};
 
 impl TexImage {
-    /// The image with its mipmap built (once; a third more memory, in the image's own texel type).
-    pub fn with_mipmaps(mut self) -> TexImage {
+    /// The image with its mipmap built (once; a third more memory, in the image's own texel type), or
+    /// [`Error::OutOfMemory`] when a level cannot be allocated.
+    pub fn with_mipmaps(mut self) -> Result<TexImage> {
         if self.mips.is_empty() {
-            self.mips = build(&self);
+            self.mips = build(&self)?;
         }
-        self
+        Ok(self)
     }
 
     /// Trilinear filtering (Williams 1983): bilinear in the two levels around the level of detail of
@@ -37,17 +39,17 @@ impl TexImage {
 }
 
 /// Levels 1 and up of `base`'s mipmap (none for a 1x1 image).
-fn build(base: &TexImage) -> Vec<TexImage> {
+fn build(base: &TexImage) -> Result<Vec<TexImage>> {
     let mut levels: Vec<TexImage> = Vec::new();
     loop {
         let prev = levels.last().unwrap_or(base);
         let (w, h) = (prev.width, prev.height);
         if w == 1 && h == 1 {
-            return levels;
+            return Ok(levels);
         }
         let texels = match &prev.texels {
-            Texels::U8(t) => Texels::U8(half(t, w, h)),
-            Texels::F32(t) => Texels::F32(half(t, w, h)),
+            Texels::U8(t) => Texels::U8(half(t, w, h)?),
+            Texels::F32(t) => Texels::F32(half(t, w, h)?),
         };
         levels.push(TexImage::from_texels(halved(w), halved(h), texels));
     }
@@ -105,9 +107,14 @@ impl Channel for f32 {
 }
 
 /// The next level of RGB texels `src` (`w` x `h`, row-major).
-fn half<T: Channel>(src: &[T], w: u32, h: u32) -> Vec<T> {
+fn half<T: Channel>(src: &[T], w: u32, h: u32) -> Result<Vec<T>> {
     let (hw, hh) = (halved(w), halved(h));
-    let mut out = Vec::with_capacity(3 * hw as usize * hh as usize);
+    let n = 3 * hw as usize * hh as usize;
+    let mut out = Vec::new();
+    if out.try_reserve_exact(n).is_err() {
+        let gib = (n * std::mem::size_of::<T>()) as f64 / (1u64 << 30) as f64;
+        return Err(Error::OutOfMemory(format!("not enough memory for its mipmap's {hw}x{hh} level ({gib:.1} GiB)")));
+    }
     for y in 0..hh {
         let (y0, y1) = span(y, h);
         for x in 0..hw {
@@ -124,7 +131,7 @@ fn half<T: Channel>(src: &[T], w: u32, h: u32) -> Vec<T> {
             }
         }
     }
-    out
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -151,7 +158,7 @@ mod tests {
             8, 12, 30, 40,
             100, 100, 1, 2,
             100, 100, 3, 5,
-        ]).with_mipmaps();
+        ]).with_mipmaps().unwrap();
         assert_eq!(img.levels(), 3);
         let l1 = img.level(1);
         assert_eq!((l1.width, l1.height), (2, 2));
@@ -167,29 +174,29 @@ mod tests {
     #[test]
     fn mipmap_odd_sides_fold_their_last_texel_into_the_last_box() {
         // 5x1: boxes {0, 1} and {2, 3, 4}; then 2x1 -> 1x1.
-        let img = grey(5, 1, &[10, 20, 30, 60, 90]).with_mipmaps();
+        let img = grey(5, 1, &[10, 20, 30, 60, 90]).with_mipmaps().unwrap();
         assert_eq!(img.levels(), 3);
         assert_eq!((img.level(1).width, img.level(1).height), (2, 1));
         assert_eq!(greys(img.level(1)), [15.0, 60.0]);
         assert_eq!(greys(img.level(2)), [38.0]);
         // 3x3: one box of all nine.
-        let img = grey(3, 3, &[0, 9, 0, 9, 0, 9, 0, 9, 0]).with_mipmaps();
+        let img = grey(3, 3, &[0, 9, 0, 9, 0, 9, 0, 9, 0]).with_mipmaps().unwrap();
         assert_eq!(img.levels(), 2);
         assert_eq!(greys(img.level(1)), [4.0]);
         // A 1x1 image has no levels to build.
-        assert_eq!(grey(1, 1, &[7]).with_mipmaps().levels(), 1);
+        assert_eq!(grey(1, 1, &[7]).with_mipmaps().unwrap().levels(), 1);
     }
 
     #[test]
     fn mipmap_float_levels_stay_unrounded() {
-        let img = TexImage::from_texels(2, 1, Texels::F32(vec![0.5, 1.0, 2.0, 1.0, 2.0, 4.0])).with_mipmaps();
+        let img = TexImage::from_texels(2, 1, Texels::F32(vec![0.5, 1.0, 2.0, 1.0, 2.0, 4.0])).with_mipmaps().unwrap();
         assert!(!img.level(1).is_8bit());
         assert_eq!(img.level(1).texel(0, 0), Color::new(0.75, 1.5, 3.0));
     }
 
     #[test]
     fn mipmap_level_of_detail_is_the_footprint_in_texels() {
-        let img = grey(8, 8, &[0; 64]).with_mipmaps();
+        let img = grey(8, 8, &[0; 64]).with_mipmaps().unwrap();
         // One texel per footprint: level 0; two: 1; four: 2; beyond the 1x1 level: clamped to 3.
         assert_eq!(lod(&img, 1.0 / 8.0), 0.0);
         assert_eq!(lod(&img, 2.0 / 8.0), 1.0);
@@ -200,7 +207,7 @@ mod tests {
             assert_eq!(lod(&img, f), 0.0, "{f}");
         }
         // A non-square image counts sqrt(width * height) texels per unit: 32x2 is 8 per unit.
-        let wide = grey(32, 2, &[0; 64]).with_mipmaps();
+        let wide = grey(32, 2, &[0; 64]).with_mipmaps().unwrap();
         assert_eq!(lod(&wide, 4.0 / 8.0), 2.0);
         // Without a mipmap there is only level 0.
         assert_eq!(lod(&grey(8, 8, &[0; 64]), 1.0), 0.0);
@@ -209,7 +216,7 @@ mod tests {
     #[test]
     fn mipmap_trilinear_blends_the_two_levels_around_the_level_of_detail() {
         // 2x2 of 0, 100 / 200, 40: level 1 is the 1x1 mean 85.
-        let img = grey(2, 2, &[0, 100, 200, 40]).with_mipmaps();
+        let img = grey(2, 2, &[0, 100, 200, 40]).with_mipmaps().unwrap();
         let at = Vec2::new(0.25, 0.25);
         // Level 0 alone at a texel centre: that texel.
         assert_eq!(img.trilinear(at, 0.0).x, 0.0);

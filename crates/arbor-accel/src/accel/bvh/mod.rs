@@ -14,9 +14,9 @@
 //!
 //! Over a triangle mesh the wide tree's leaves hold their own copies of the triangles and their
 //! indices, so the build drops the binary tree and the index array once collapsed, keeping the root
-//! box and the statistics taken before; the boxes debug view then shows the wide tree's boxes (the
-//! root's, then each wide node's child boxes), and [`Accel::validate`] checks the wide tree
-//! (`wide/check.rs`). Other primitives keep both: their leaves read the index array.
+//! box and the statistics taken before; the boxes debug view builds the binary tree again
+//! (`recipe.rs`), so that its depths stay the ones the statistics count, and [`Accel::validate`] checks
+//! the wide tree (`wide/check.rs`). Other primitives keep both: their leaves read the index array.
 //!
 //! Invariants of the binary tree (checked by [`Accel::validate`], which the factory runs in debug builds):
 //! - every node's box encloses its children's boxes and its primitives' boxes;
@@ -37,6 +37,7 @@ mod bottom_up;
 mod build;
 mod median;
 mod params;
+mod recipe;
 mod sah;
 mod traverse;
 mod validate;
@@ -46,6 +47,7 @@ use std::time::{Duration, Instant};
 
 pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 pub use params::{BvhParams, MedianParams};
+use recipe::Recipe;
 use wide::Kernel;
 pub use wide::{Node8, Wide};
 
@@ -120,12 +122,11 @@ impl Node {
 }
 
 /// Whether a BVH over a triangle mesh keeps its binary tree and index array after the collapse: its
-/// queries read only the wide tree and its triangle blocks, so the public builders drop them; tests
-/// that inspect the binary tree keep it.
+/// queries read only the wide tree and its triangle blocks, so the public builders drop them; the
+/// boxes view and tests that inspect the binary tree keep it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Binary {
     DropForMesh,
-    #[cfg(test)]
     Keep,
 }
 
@@ -142,7 +143,7 @@ pub struct Bvh {
     /// The binary tree's statistics, taken before it was dropped (`bytes` and `build_time` are filled
     /// in when asked); `None` while the tree is kept, whose statistics are computed when asked.
     dropped_stats: Option<AccelStats>,
-    kind: &'static str,
+    recipe: Recipe,
     build_time: Duration,
 }
 
@@ -154,12 +155,13 @@ impl Bvh {
 
     pub(crate) fn sah<P: Primitives + ?Sized>(prims: &P, params: &BvhParams, binary: Binary) -> Bvh {
         let start = Instant::now();
+        let recipe = Recipe::Sah(*params);
         let mut params = params.sanitized();
         if prims.triangle_mesh().is_none() {
             params.leaf_block = 1;
         }
         let (nodes, prim_indices, live) = sah::build_sah(prims, &params);
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-sah", start, binary)
+        Bvh::from_flat(prims, nodes, prim_indices, live, recipe, start, binary)
     }
 
     /// Builds a BVH over `prims` by splitting at the median centroid on the longest axis (see
@@ -172,7 +174,7 @@ impl Bvh {
         let start = Instant::now();
         let bvh_params = BvhParams { max_leaf_prims: params.max_leaf_prims, ..BvhParams::default() };
         let (nodes, prim_indices, live) = median::build_median(prims, &bvh_params.sanitized());
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-median", start, binary)
+        Bvh::from_flat(prims, nodes, prim_indices, live, Recipe::Median(*params), start, binary)
     }
 
     /// Builds a BVH over `prims` bottom-up, by the exact greedy method or PLOC (see `bottom_up/`).
@@ -183,7 +185,7 @@ impl Bvh {
     pub(crate) fn bottom_up<P: Primitives + ?Sized>(prims: &P, params: &BottomUpParams, binary: Binary) -> Bvh {
         let start = Instant::now();
         let (nodes, prim_indices, live) = bottom_up::build(prims, params);
-        Bvh::from_flat(prims, nodes, prim_indices, live, "bvh-bottom-up", start, binary)
+        Bvh::from_flat(prims, nodes, prim_indices, live, Recipe::BottomUp(params.clone()), start, binary)
     }
 
     /// Wraps a flat node array written by any builder (the traversal and checks are shared), collapses
@@ -193,10 +195,11 @@ impl Bvh {
         nodes: Vec<Node>,
         prim_indices: Vec<u32>,
         live: usize,
-        kind: &'static str,
+        recipe: Recipe,
         start: Instant,
         binary: Binary,
     ) -> Bvh {
+        let kind = recipe.kind();
         let drop = binary == Binary::DropForMesh && prims.triangle_mesh().is_some();
         // The statistics describe the binary tree, so when it is to be dropped they are taken now, as
         // part of the build, by a walk that needs nothing from the collapse: the two run side by side.
@@ -214,7 +217,7 @@ impl Bvh {
             bounds,
             wide,
             dropped_stats,
-            kind,
+            recipe,
             build_time: Duration::ZERO,
         };
         if drop {
@@ -321,9 +324,9 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
         wide::intersect_many_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
     }
 
-    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+    fn boxes_at_depth(&self, prims: &P, depth: usize) -> Vec<Aabb> {
         if self.binary_dropped() {
-            return self.wide.boxes_at_depth(self.bounds, depth);
+            return Accel::<P>::boxes_at_depth(&self.recipe.build_kept(prims), prims, depth);
         }
         let mut out = Vec::new();
         let mut stack = if self.nodes.is_empty() { vec![] } else { vec![(0usize, 0usize)] };
@@ -348,7 +351,7 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
     }
 
     fn stats(&self) -> AccelStats {
-        self.compute_stats(self.kind, self.build_time)
+        self.compute_stats(self.recipe.kind(), self.build_time)
     }
 
     fn validate(&self, prims: &P) -> Result<(), String> {

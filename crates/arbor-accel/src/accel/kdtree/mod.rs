@@ -386,7 +386,7 @@ impl<P: Primitives + ?Sized> Accel<P> for KdTree {
         self.check(&|i| prims.bounds(i), prims.len())
     }
 
-    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+    fn boxes_at_depth(&self, _: &P, depth: usize) -> Vec<Aabb> {
         let mut out = Vec::new();
         self.walk(|_, _, b, d| {
             if d == depth {

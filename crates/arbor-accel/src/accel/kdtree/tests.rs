@@ -61,7 +61,7 @@ fn kdtree_empty_set_hits_nothing() {
     assert!(!tree.occluded(&mesh, &ray, f32::INFINITY));
     assert!(Accel::<TriangleMesh>::bounds(&tree).is_empty());
     assert_eq!(Accel::<TriangleMesh>::stats(&tree).nodes, 0);
-    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0).is_empty());
+    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 0).is_empty());
 }
 
 #[test]
@@ -241,8 +241,8 @@ fn kdtree_boxes_at_depth_tile_the_root() {
     let mesh = soup(800, 17);
     let tree = KdTree::build(&mesh, &KdTreeParams::default());
     let root = Accel::<TriangleMesh>::bounds(&tree);
-    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0), vec![root]);
-    let level: Vec<Aabb> = Accel::<TriangleMesh>::boxes_at_depth(&tree, 1);
+    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 0), vec![root]);
+    let level: Vec<Aabb> = Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 1);
     assert_eq!(level.len(), 2);
     let volume = |b: &Aabb| b.extent().x * b.extent().y * b.extent().z;
     assert!((level.iter().map(volume).sum::<f32>() - volume(&root)).abs() <= 1e-3 * volume(&root));

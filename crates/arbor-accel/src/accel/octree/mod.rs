@@ -307,7 +307,7 @@ impl<P: Primitives + ?Sized> Accel<P> for Octree {
     }
 
     /// The cells at `depth`, leaving out empty leaves (regions holding nothing).
-    fn boxes_at_depth(&self, depth: usize) -> Vec<Aabb> {
+    fn boxes_at_depth(&self, _: &P, depth: usize) -> Vec<Aabb> {
         let mut out = Vec::new();
         self.for_each_cell(|node, cell, d| {
             if d == depth && !(node.is_leaf() && node.count == 0) {

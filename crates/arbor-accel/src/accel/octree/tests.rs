@@ -52,7 +52,7 @@ fn octree_empty_set_hits_nothing() {
     assert!(!tree.occluded(&mesh, &ray, f32::INFINITY));
     assert!(Accel::<TriangleMesh>::bounds(&tree).is_empty());
     assert_eq!(Accel::<TriangleMesh>::stats(&tree).nodes, 0);
-    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0).is_empty());
+    assert!(Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 0).is_empty());
 }
 
 #[test]
@@ -149,8 +149,8 @@ fn octree_stats_and_boxes_describe_the_tree() {
     assert!(s.refs_per_prim >= 1.0 && s.mean_leaf_prims > 0.0 && s.sah_cost > 0.0 && s.bytes > 0);
     assert_eq!((s.nodes - 1) % 8, 0);
     let root = tree.root();
-    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, 0), vec![root]);
-    let level1 = Accel::<TriangleMesh>::boxes_at_depth(&tree, 1);
+    assert_eq!(Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 0), vec![root]);
+    let level1 = Accel::<TriangleMesh>::boxes_at_depth(&tree, &mesh, 1);
     assert!(!level1.is_empty() && level1.len() <= 8);
     assert!(level1.iter().all(|b| root.contains(b)));
     let e = root.extent();

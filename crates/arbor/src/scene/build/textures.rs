@@ -1,6 +1,7 @@
 //! The textures of a description as runtime types: every image that a map samples is read once, in
-//! parallel, and shared by the maps that name it; an unreadable image is an error at the `Image`
-//! element that names it. An image gets its mipmap when a trilinear map samples it, and only then.
+//! parallel (within the images' pixel budget), and shared by the maps that name it; an unreadable image,
+//! one above the budget or one without the memory it needs, is an error at the `Image` element that
+//! names it. An image gets its mipmap when a trilinear map samples it, and only then.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -8,12 +9,13 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use crate::image_io::ImageLimits;
 use crate::scene::desc::{DecalMode, Interpolation, NoiseConversion, SceneDesc, TextureDesc, TextureSource};
 use crate::texture::{Checkerboard, Decal, Filter, Source, TexImage, Texture};
 use crate::{Error, Result};
 
-/// The runtime textures of `desc`, in its order.
-pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
+/// The runtime textures of `desc`, in its order, each image held to `limits`.
+pub fn build_textures(desc: &SceneDesc, limits: &ImageLimits) -> Result<Vec<Texture>> {
     let mut wanted: Vec<usize> = desc
         .textures
         .iter()
@@ -42,7 +44,10 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
         .par_iter()
         .map(|&i| {
             let img = &desc.images[i];
-            let image = TexImage::load(&img.path).map_err(|e| {
+            let trilinear = mipmapped.contains(img.path.as_path());
+            let image = TexImage::load(&img.path, limits);
+            let image = image.and_then(|image| if trilinear { image.with_mipmaps() } else { Ok(image) });
+            let image = image.map_err(|e| {
                 let why = match e {
                     Error::Io { source, .. } => source.to_string(),
                     Error::Input { msg, .. } => msg,
@@ -50,7 +55,6 @@ pub fn build_textures(desc: &SceneDesc) -> Result<Vec<Texture>> {
                 };
                 Error::input(img.loc.clone(), format!("cannot read texture image '{}': {why}", img.path.display()))
             })?;
-            let image = if mipmapped.contains(img.path.as_path()) { image.with_mipmaps() } else { image };
             Ok((img.path.as_path(), Arc::new(image)))
         })
         .collect::<Result<_>>()?;
@@ -120,7 +124,7 @@ mod tests {
         }
         desc.textures =
             vec![map(0, Interpolation::Nearest), map(0, Interpolation::Bilinear), map(1, Interpolation::Nearest)];
-        let t = build_textures(&desc).unwrap();
+        let t = build_textures(&desc, &ImageLimits::DEFAULT).unwrap();
         let image = |t: &Texture| match &t.source {
             Source::Image { image, .. } => image.clone(),
             _ => unreachable!(),
@@ -142,7 +146,7 @@ mod tests {
         desc.images.push(desc.images[0].clone());
         desc.textures =
             vec![map(2, Interpolation::Nearest), map(0, Interpolation::Trilinear), map(1, Interpolation::Bilinear)];
-        let t = build_textures(&desc).unwrap();
+        let t = build_textures(&desc, &ImageLimits::DEFAULT).unwrap();
         let levels = |t: &Texture| match &t.source {
             Source::Image { image, .. } => image.levels(),
             _ => unreachable!(),
@@ -157,7 +161,7 @@ mod tests {
         let loc = Location { line: Some(3), col: Some(7), ..Location::file("t.xml") };
         desc.images.push(ImageDesc { path: "/nonexistent/a.png".into(), loc });
         desc.textures = vec![map(0, Interpolation::Nearest)];
-        let e = build_textures(&desc).unwrap_err().to_string();
+        let e = build_textures(&desc, &ImageLimits::DEFAULT).unwrap_err().to_string();
         assert!(e.starts_with("t.xml:3:7: cannot read texture image '/nonexistent/a.png': "), "{e}");
     }
 }

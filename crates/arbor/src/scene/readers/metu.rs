@@ -17,6 +17,10 @@
 //!   shows no reflection from its untyped `MirrorReflectance` at depth 6);
 //! - an absent `MaxRecursionDepth` is 0 in XML (the 2024 official parser) and 6 in the 2025 JSON form,
 //!   whose `bunny_with_plane.png` reference shows its mirror plane with no depth given;
+//! - camera rays cull back faces in the 2025 JSON form unless `BackfaceCulling` says otherwise: its
+//!   official images are culled (hw3 `cornellbox_boxes_dynamic.png` shows the boxes through the front
+//!   wall's back, which an unculled render shows instead). The XML form does not tell its year (the 2022
+//!   references are unculled, the 2021 ones culled), so it leaves the choice to the user (`--cull`);
 //! - duplicated single-valued elements: the last one wins, with a warning;
 //! - what Arbor does not render (emission, path tracing...) is one warning per
 //!   element name, and whatever is never read is reported as ignored ([`Node::unused`]).
@@ -47,7 +51,11 @@ pub fn read(root: &Node, path: &Path, form: Form) -> Result<SceneDesc> {
     let mut r = Reader {
         path,
         dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
-        desc: SceneDesc { max_depth: if form == Form::Json { 6 } else { 0 }, ..SceneDesc::new(path) },
+        desc: SceneDesc {
+            max_depth: if form == Form::Json { 6 } else { 0 },
+            cull_backfaces: (form == Form::Json).then_some(true),
+            ..SceneDesc::new(path)
+        },
         legacy: form == Form::Xml && !typed_materials(root) && !texture_maps(root),
         notes: Notes::default(),
         vertices: Vec::new(),

@@ -9,7 +9,8 @@
 //! carry the line of the offending key, thanks to the positions kept by [`super::json`].
 //!
 //! Shading is local, as the assignment's reference renderer does it: ambient plus Blinn-Phong from every
-//! light, with no shadow rays and no reflection, whatever `Mirror` says. The reference `bunny.png`
+//! light, with no shadow rays and no reflection, whatever `Mirror` says, and on both sides of a surface
+//! (no back-face culling). The reference `bunny.png`
 //! matches this to within one level in every pixel, and differs in 4% of its pixels once shadows or
 //! mirror bounces are added.
 
@@ -46,6 +47,8 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneDesc> {
     desc.max_depth = 0;
     desc.shadows = false;
     desc.flip_back_faces = true;
+    // Nor does it cull: camera rays see back faces (no warning suggests `--cull` either).
+    desc.cull_backfaces = Some(false);
     let mut warn = Vec::new();
     if let Some(scene) = top.get("Scene") {
         let scene = Obj::new(&scene.value, "Scene", path)?;
@@ -111,6 +114,7 @@ fn camera(c: &Obj<'_>, at: &Member, warn: &mut Vec<String>) -> Result<CameraDesc
         width: WIDTH,
         height: HEIGHT,
         image_name: format!("{stem}.png"),
+        name_loc: c.loc(at),
         num_samples: 1,
         transform: Transform::IDENTITY,
         lens: None,

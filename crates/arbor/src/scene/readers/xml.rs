@@ -1,5 +1,10 @@
 //! METU XML scene files to the element tree ([`super::tree`]), with roxmltree.
 //!
+//! Entity declarations (`<!ENTITY>`) are refused: no scene format uses them (no course file has a DTD),
+//! and roxmltree bounds only the depth and count of references, not the text they expand to, so a 53 KB
+//! file of two levels expands to gigabytes. With none declared, only the five predefined entities and
+//! character references remain, each one character.
+//!
 //! Positions come from the document's byte ranges. roxmltree's own `text_pos_at` rescans the text
 //! from the start on every call, which is quadratic on the multi-megabyte files with inline vertex data;
 //! a table of line starts turns each lookup into a binary search, and the column is counted on from the
@@ -27,14 +32,24 @@ pub fn parse(text: &str, path: &Path) -> Result<Node> {
         Error::input(Location::at(path, row, col), format!("XML syntax error: {msg}"))
     };
     // roxmltree recurses once per nesting level and would overflow the stack on a hostile file before
-    // `convert` could refuse it. Errors stay in document order: a syntax error before the deep element
-    // is still the one reported, found by parsing only the text before it.
-    if let Some(at) = too_deep(text) {
+    // `convert` could refuse it, and expands entities without bound. Errors stay in document order: a
+    // syntax error before the refused element or declaration is still the one reported, found by parsing
+    // only the text before it.
+    if let Some((at, refused)) = prescan(text) {
+        // The text stops at `at`: an error there (an unclosed root, an unfinished DOCTYPE) is the cut's.
         match roxmltree::Document::parse_with_options(&text[..at], opts) {
             Err(roxmltree::Error::UnexpectedEndOfStream | roxmltree::Error::UnclosedRootNode) | Ok(_) => {}
+            Err(e) if (e.pos().row, e.pos().col) == lines.pos(at) => {}
             Err(e) => return Err(syntax_error(e, &mut lines)),
         }
-        return Err(nested_too_deep(path, lines.pos(at)));
+        return Err(match refused {
+            Refused::TooDeep => nested_too_deep(path, lines.pos(at)),
+            Refused::Entity => {
+                let (line, col) = lines.pos(at);
+                let msg = "entity declarations (<!ENTITY>) are not supported: no scene format uses them";
+                Error::input(Location::at(path, line, col), msg)
+            }
+        });
     }
     let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| syntax_error(e, &mut lines))?;
     convert(doc.root_element(), &mut lines, 0, path)
@@ -70,12 +85,20 @@ fn nested_too_deep(path: &Path, (line, col): (u32, u32)) -> Error {
     Error::input(Location::at(path, line, col), format!("elements nested more than {MAX_DEPTH} deep"))
 }
 
-/// The byte offset of the first element with more than [`MAX_DEPTH`] open ancestors, or of such an
-/// element in an entity's value, found by a forward scan that tokenizes only as far as roxmltree's
-/// nesting goes. Where the scan gives up (an unterminated comment, an unknown declaration), roxmltree
-/// stops with a syntax error at the same place, so nothing deeper is ever parsed. Nesting built up
-/// through entity references is bounded by roxmltree's own limit on their depth, and left to `convert`.
-fn too_deep(text: &str) -> Option<usize> {
+/// What the scan before parsing refuses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Refused {
+    /// An element with more than [`MAX_DEPTH`] open ancestors.
+    TooDeep,
+    /// An entity declaration in the DOCTYPE.
+    Entity,
+}
+
+/// The byte offset of the first element with more than [`MAX_DEPTH`] open ancestors or of the first
+/// entity declaration, found by a forward scan that tokenizes only as far as roxmltree's nesting goes.
+/// Where the scan gives up (an unterminated comment, an unknown declaration), roxmltree stops with a
+/// syntax error at the same place, so nothing deeper is ever parsed and no entity declared.
+fn prescan(text: &str) -> Option<(usize, Refused)> {
     let b = text.as_bytes();
     let mut depth = 0usize;
     let mut i = 0;
@@ -91,7 +114,7 @@ fn too_deep(text: &str) -> Option<usize> {
         } else if rest.starts_with(b"<!DOCTYPE") {
             match doctype(text, at + 9)? {
                 Ok(end) => end,
-                Err(deep) => return Some(deep),
+                Err(entity) => return Some((entity, Refused::Entity)),
             }
         } else if rest.starts_with(b"<!") {
             return None;
@@ -100,7 +123,7 @@ fn too_deep(text: &str) -> Option<usize> {
             after(text, at + 2, ">")?
         } else {
             if depth > MAX_DEPTH {
-                return Some(at);
+                return Some((at, Refused::TooDeep));
             }
             let end = tag_end(text, at + 1)?;
             if b[end - 2] != b'/' {
@@ -133,9 +156,9 @@ fn tag_end(text: &str, mut i: usize) -> Option<usize> {
     }
 }
 
-/// The end of a DOCTYPE whose name starts at `i` (`Ok`), or the offset of an element nested too deep in
-/// one of its entity values (`Err`). Follows roxmltree's grammar: quoted literals in the external ID and
-/// in entity declarations, other declarations up to the first `>` whatever their quotes.
+/// The end of a DOCTYPE whose name starts at `i` (`Ok`), or the offset of its first entity declaration
+/// (`Err`). Follows roxmltree's grammar: quoted literals in the external ID, other declarations up to the
+/// first `>` whatever their quotes.
 fn doctype(text: &str, mut i: usize) -> Option<Result<usize, usize>> {
     let b = text.as_bytes();
     loop {
@@ -152,20 +175,10 @@ fn doctype(text: &str, mut i: usize) -> Option<Result<usize, usize>> {
     loop {
         let at = i + text.get(i..)?.find(|c: char| !c.is_ascii_whitespace())?;
         let rest = &b[at..];
-        i = if rest.starts_with(b"<!ENTITY") {
-            let mut j = at + 8;
-            loop {
-                let k = j + text.get(j..)?.find(['>', '"', '\''])?;
-                if b[k] == b'>' {
-                    break k + 1;
-                }
-                let end = after_quoted(text, k)?;
-                if let Some(deep) = too_deep(&text[k + 1..end - 1]) {
-                    return Some(Err(k + 1 + deep));
-                }
-                j = end;
-            }
-        } else if rest.starts_with(b"<!--") {
+        if rest.starts_with(b"<!ENTITY") {
+            return Some(Err(at));
+        }
+        i = if rest.starts_with(b"<!--") {
             after(text, at + 4, "-->")?
         } else if rest.starts_with(b"<?") {
             after(text, at + 2, "?>")?
@@ -310,11 +323,11 @@ mod tests {
         // A root and 128 levels below it are allowed; no `<` below that which is not an element counts.
         let inner = "<!-- <a> --><![CDATA[<a>]]><?pi <a>?><b x=\"a>\" y='/>'/>";
         let text = format!(
-            "<?xml version=\"1.0\"?><!DOCTYPE a [<!ENTITY e \"<a/>\"><!-- <a> --><!ELEMENT a ANY>]>{}{inner}{}",
+            "<?xml version=\"1.0\"?><!DOCTYPE a [<!-- <a> <!ENTITY e 'x'> --><!ELEMENT a ANY>]>{}{inner}{}",
             "<a>".repeat(128),
             "</a>".repeat(128)
         );
-        assert_eq!(too_deep(&text), None);
+        assert_eq!(prescan(&text), None);
         parse(&text, Path::new("s.xml")).unwrap();
         let text = text.replacen("]><a>", "]><a><a>", 1);
         let e = parse(&text, Path::new("s.xml")).unwrap_err();
@@ -322,11 +335,37 @@ mod tests {
     }
 
     #[test]
-    fn xml_depth_scan_reads_entity_values() {
+    fn xml_entity_declarations_are_refused_before_parsing() {
+        // Two levels, about 12 GB of text once expanded (roxmltree allows 255 references per reference).
+        let big = "x".repeat(20_000);
+        let text = format!(
+            "<?xml version=\"1.0\"?>\n<!DOCTYPE Scene [\n  <!ELEMENT Scene ANY>\n  <!ENTITY a \"{big}\">\n  \
+             <!ENTITY b \"{}\">\n]>\n<Scene>{}</Scene>\n",
+            "&a;".repeat(255),
+            "&b;".repeat(2400)
+        );
+        let e = parse(&text, Path::new("bomb.xml")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "bomb.xml:4:3: entity declarations (<!ENTITY>) are not supported: no scene format uses them"
+        );
+        // Parameter and external entities too, and one inside a deep value is found before the depth.
         let deep = format!("{}{}", "<a>".repeat(20_000), "</a>".repeat(20_000));
-        let text = format!("<!DOCTYPE r [\n<!ENTITY e '{deep}'>\n]>\n<r>&e;</r>");
-        let e = parse(&text, Path::new("ent.xml")).unwrap_err();
-        assert_eq!(e.to_string(), "ent.xml:2:400: elements nested more than 128 deep");
+        for decl in ["<!ENTITY % p 'x'>", "<!ENTITY e SYSTEM \"file:///etc/passwd\">", &format!("<!ENTITY e '{deep}'>")]
+        {
+            let text = format!("<!DOCTYPE r [\n<!ELEMENT r ANY> {decl}\n]>\n<r/>");
+            let e = parse(&text, Path::new("ent.xml")).unwrap_err();
+            assert!(e.to_string().starts_with("ent.xml:2:18: entity declarations"), "{e}");
+        }
+        // The five predefined entities and character references still read.
+        let root = parse("<!DOCTYPE r><r a=\"&lt;&#65;\">&amp;&gt;&quot;&apos;&#x42;</r>", Path::new("s.xml")).unwrap();
+        assert_eq!((root.attrs[0].value.as_str(), root.trimmed()), ("<A", "&>\"'B"));
+    }
+
+    #[test]
+    fn xml_syntax_error_before_an_entity_declaration_is_reported_first() {
+        let e = parse("<!DOCTYPE 1r [\n<!ENTITY e 'x'>\n]>\n<r>&e;</r>", Path::new("bad.xml")).unwrap_err();
+        assert!(e.to_string().starts_with("bad.xml:1:11: XML syntax error"), "{e}");
     }
 
     #[test]

@@ -1,6 +1,6 @@
-//! What remains of a mesh BVH once its binary tree is dropped, walked for the boxes debug view and
-//! checked for [`Accel::validate`](crate::accel::Accel::validate): the checks of `../validate.rs`
-//! restated for the wide tree and its triangle blocks. O(n) time and memory.
+//! What remains of a mesh BVH once its binary tree is dropped, checked for
+//! [`Accel::validate`](crate::accel::Accel::validate): the checks of `../validate.rs` restated for the
+//! wide tree and its triangle blocks. O(n) time and memory.
 
 use super::super::{LEAF_HARD_MAX, MAX_DEPTH};
 use super::{Node8, Ref, Wide, WIDTH};
@@ -22,30 +22,6 @@ impl Wide {
     /// True when the leaves are triangle blocks (the primitives were a mesh).
     pub(in crate::accel::bvh) fn has_blocks(&self) -> bool {
         self.blocks.is_some()
-    }
-
-    /// The boxes at `depth` of the wide tree: the root's box (`bounds`) at depth 0, then the lanes of
-    /// the wide nodes at depth `depth - 1`.
-    pub(in crate::accel::bvh) fn boxes_at_depth(&self, bounds: Aabb, depth: usize) -> Vec<Aabb> {
-        let mut out = Vec::new();
-        match self.root {
-            None => {}
-            Some(_) if depth == 0 => out.push(bounds),
-            Some(Ref { count: 0, .. }) => {
-                let mut stack = vec![(0usize, 1usize)];
-                while let Some((i, d)) = stack.pop() {
-                    for (b, r) in (0..WIDTH).filter_map(|l| lane(&self.nodes[i], l)) {
-                        if d == depth {
-                            out.push(b);
-                        } else if r.count == 0 {
-                            stack.push((r.child as usize, d + 1));
-                        }
-                    }
-                }
-            }
-            Some(_) => {}
-        }
-        out
     }
 
     /// Checks the wide tree over `mesh` built from `primitives` primitives of which `live` are in the

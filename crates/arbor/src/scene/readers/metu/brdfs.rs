@@ -5,8 +5,9 @@
 //!
 //! Torrance-Sparrow's Fresnel term takes the material's `RefractionIndex` and `AbsorptionIndex` (the
 //! 2022 files), else the model's own `RefractiveIndex` (the 2019 files), with no absorption.
-//! A model the course does not define, a negative exponent, or a material naming an id no model has
-//! is a located error.
+//! A model the course does not define, a negative exponent, a refraction index that is not positive (the
+//! model's or the material's, as for any material), a negative absorption index, or a material naming
+//! an id no model has is a located error.
 
 use super::Reader;
 use crate::scene::desc::{BrdfDesc, BrdfKind};
@@ -46,7 +47,8 @@ impl Reader<'_> {
                 "OriginalBlinnPhong" => BrdfKind::OriginalBlinnPhong,
                 "ModifiedBlinnPhong" => BrdfKind::ModifiedBlinnPhong { normalized: flag(self, "normalized")? },
                 "TorranceSparrow" => {
-                    eta = self.one(n, "RefractiveIndex").map(|r| r.float(p)).transpose()?;
+                    let who = format!("BRDF {id}");
+                    eta = self.one(n, "RefractiveIndex").map(|r| self.refraction_index(r, &who)).transpose()?;
                     BrdfKind::TorranceSparrow { kd_fresnel: flag(self, "kdfresnel")?, eta: 0.0, k: 0.0 }
                 }
                 other => {
@@ -73,9 +75,10 @@ impl Reader<'_> {
             return Err(Error::input(a.loc(p), format!("Material {id}: unknown BRDF id '{name}'")));
         };
         let mut desc = entry.desc;
+        let who = format!("Material {id}");
         if let BrdfKind::TorranceSparrow { eta, k, .. } = &mut desc.kind {
             *eta = match (self.one(m, "RefractionIndex"), entry.eta) {
-                (Some(n), _) => n.float(p)?,
+                (Some(n), _) => self.refraction_index(n, &who)?,
                 (None, Some(e)) => e,
                 (None, None) => {
                     let msg = format!(
@@ -84,7 +87,7 @@ impl Reader<'_> {
                     return Err(Error::input(a.loc(p), msg));
                 }
             };
-            *k = self.one(m, "AbsorptionIndex").map(|n| n.float(p)).transpose()?.unwrap_or(0.0);
+            *k = self.one(m, "AbsorptionIndex").map(|n| self.absorption_index(n, &who)).transpose()?.unwrap_or(0.0);
         }
         Ok(Some(desc))
     }

@@ -1,7 +1,8 @@
 //! METU cameras: the image-plane window from `NearPlane`, or for `type="lookAt"` from `FovY` and the
 //! image's aspect ratio (`top = NearDistance·tan(FovY/2)`, `right = top·width/height`), the camera's
 //! transformations and its thin lens. The image plane lies in front of the eye (`NearDistance` > 0)
-//! and its window is neither empty nor inverted (left < right, bottom < top; `FovY` in (0, 180)).
+//! and its window is neither empty nor inverted (left < right, bottom < top; `FovY` in (0, 180)) nor so
+//! wide that its width or height overflows `f32`.
 
 use super::Reader;
 use crate::renderer::{PathOptions, Renderer, Roulette};
@@ -9,6 +10,20 @@ use crate::scene::desc::{CameraDesc, Lens, Window};
 use crate::scene::readers::tree::Node;
 use crate::tonemap::{Operator, Tonemap};
 use crate::{Error, Result};
+
+/// How a window's size that leaves the range of `f32` is said.
+const OVERFLOWS: &str = "overflows to infinity (beyond the range of 32-bit floats)";
+
+/// `width` or `height` when that side of `w` is not a finite number: the pixel grid would be NaN.
+fn overflowing_side(w: &Window) -> Option<&'static str> {
+    if !(w.right - w.left).is_finite() {
+        Some("width")
+    } else if !(w.top - w.bottom).is_finite() {
+        Some("height")
+    } else {
+        None
+    }
+}
 
 impl Reader<'_> {
     /// One `Camera`; `index` (from 0) names it when it has no id.
@@ -67,7 +82,16 @@ impl Reader<'_> {
             }
             let top = near_distance * (fov_deg.to_radians() / 2.0).tan();
             let right = top * width as f32 / height as f32;
-            (gaze, Window { left: -right, right, bottom: -top, top })
+            let window = Window { left: -right, right, bottom: -top, top };
+            if let Some(side) = overflowing_side(&window) {
+                // Only a huge distance can overflow (tan of FovY below 180 stays under 1e7 in f32).
+                let msg = format!(
+                    "Camera {id}: the window of NearDistance {near_distance:e} and FovY {fov_deg} has a {side} that \
+                     {OVERFLOWS}"
+                );
+                return Err(self.err(fov_node, msg));
+            }
+            (gaze, window)
         } else {
             let gaze = self.req(c, "Gaze")?.vec3(p)?;
             let np = self.req(c, "NearPlane")?;
@@ -84,7 +108,11 @@ impl Reader<'_> {
                     return Err(self.err(np, format!("Camera {id}: NearPlane {a} {low} must be less than {b} {high}")));
                 }
             }
-            (gaze, Window { left: v[0], right: v[1], bottom: v[2], top: v[3] })
+            let window = Window { left: v[0], right: v[1], bottom: v[2], top: v[3] };
+            if let Some(side) = overflowing_side(&window) {
+                return Err(self.err(np, format!("Camera {id}: the NearPlane window's {side} {OVERFLOWS}")));
+            }
+            (gaze, window)
         };
         if gaze.length_squared() == 0.0 {
             return Err(self.err(c, format!("Camera {id}: zero gaze direction")));
@@ -115,6 +143,7 @@ impl Reader<'_> {
             width,
             height,
             image_name,
+            name_loc: name_node.loc(p),
             num_samples,
             transform,
             lens,

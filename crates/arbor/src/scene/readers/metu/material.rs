@@ -45,21 +45,14 @@ impl Reader<'_> {
             }
             None => 1.0,
         };
-        // A refraction index must be positive, an absorption index not negative: others have no
-        // physical reading and make the Fresnel terms NaN or negative.
+        let who = format!("Material {id}");
         let refraction_index = |r: &mut Self| -> Result<f32> {
             let n = r.req(m, "RefractionIndex")?;
-            match n.float(p)? {
-                v if v <= 0.0 => Err(r.err(n, format!("Material {id}: RefractionIndex {v} must be positive"))),
-                v => Ok(v),
-            }
+            r.refraction_index(n, &who)
         };
         let absorption_index = |r: &mut Self| -> Result<f32> {
             let n = r.req(m, "AbsorptionIndex")?;
-            match n.float(p)? {
-                v if v < 0.0 => Err(r.err(n, format!("Material {id}: negative AbsorptionIndex {v}"))),
-                v => Ok(v),
-            }
+            r.absorption_index(n, &who)
         };
         let kind = match m.attr("type").map(|a| (a, a.trimmed().to_string())) {
             Some((_, t)) if t == "mirror" => {
@@ -120,6 +113,24 @@ impl Reader<'_> {
             None => 0.0,
         };
         Ok(MaterialDesc { id, ambient, diffuse, specular, phong_exponent, brdf, roughness, kind, degamma })
+    }
+
+    /// The refraction index `n` of `who` (a material's `RefractionIndex`, a Torrance-Sparrow model's
+    /// `RefractiveIndex`): positive, as others have no physical reading and make the Fresnel terms NaN
+    /// or negative.
+    pub(super) fn refraction_index(&self, n: &Node, who: &str) -> Result<f32> {
+        match n.float(self.path)? {
+            v if v <= 0.0 => Err(self.err(n, format!("{who}: {} {v} must be positive", n.name))),
+            v => Ok(v),
+        }
+    }
+
+    /// The `AbsorptionIndex` `n` of `who`: not negative (a negative one has no physical reading either).
+    pub(super) fn absorption_index(&self, n: &Node, who: &str) -> Result<f32> {
+        match n.float(self.path)? {
+            v if v < 0.0 => Err(self.err(n, format!("{who}: negative AbsorptionIndex {v}"))),
+            v => Ok(v),
+        }
     }
 
     /// A legacy opaque material's `RefractionIndex`: it has no effect (only a non-zero `Transparency`

@@ -68,6 +68,9 @@ impl Reader<'_> {
             } else {
                 let material = self.material_of(o, &name)?;
                 let shape = self.shape(o, &name)?;
+                if let ShapeDesc::Mesh { source: MeshSource::Inline(_), .. } = &shape {
+                    self.check_uvs_for_images(o, &name, &textures)?;
+                }
                 if let (Some(_), ShapeDesc::Mesh { source: MeshSource::Inline(m), .. }) = (emission, &shape) {
                     if m.indices.is_empty() {
                         return Err(self.err(o, format!("{name}: a light mesh needs at least one triangle")));

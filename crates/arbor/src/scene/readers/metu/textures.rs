@@ -53,15 +53,18 @@ impl Reader<'_> {
         let name = format!("Texture {id}");
         let file = self.req(tex, "ImageName")?;
         let decal = self.decal_mode(tex, &name)?;
-        let scale = match self.one(tex, "ScalingFactor") {
-            Some(n) => n.float(p)?,
-            None => 1.0,
-        };
-        let appearance = self.one(tex, "Appearance").map(|n| (n, n.trimmed()));
-        if matches!(file.trimmed(), "perlin" | "checkerboard") {
+        let scale = if matches!(file.trimmed(), "perlin" | "checkerboard") {
             // Procedural values are already in [0, 1]: the files' Normalizer of 1 leaves them so.
             self.positive(tex, "Normalizer", &name)?;
-        }
+            // A scale of 0 gives one value everywhere: one noise sample, one square of the board.
+            self.positive(tex, "ScalingFactor", &name)?.unwrap_or(1.0)
+        } else {
+            match self.one(tex, "ScalingFactor") {
+                Some(n) => n.float(p)?,
+                None => 1.0,
+            }
+        };
+        let appearance = self.one(tex, "Appearance").map(|n| (n, n.trimmed()));
         let source = match file.trimmed() {
             "perlin" => {
                 let conversion = match appearance {
@@ -69,9 +72,6 @@ impl Reader<'_> {
                     Some((_, "vein")) => NoiseConversion::AbsVal,
                     Some((n, other)) => return Err(self.err(n, format!("{name}: unknown Appearance '{other}'"))),
                 };
-                if scale <= 0.0 {
-                    return Err(self.err(tex, format!("{name}: ScalingFactor {scale} must be positive")));
-                }
                 TextureSource::Perlin { conversion, scale }
             }
             "checkerboard" => self.checkerboard(tex, scale)?,
@@ -149,10 +149,8 @@ impl Reader<'_> {
                 TextureSource::Perlin { conversion, scale }
             }
             "checkerboard" => {
-                let scale = match self.one(map, "Scale") {
-                    Some(n) => n.float(p)?,
-                    None => 1.0,
-                };
+                // Scale 0 puts every point in the square at the origin: one colour, no board.
+                let scale = self.positive(map, "Scale", &name)?.unwrap_or(1.0);
                 self.checkerboard(map, scale)?
             }
             other => return Err(Error::input(kind.loc(p), format!("{name}: unknown type '{other}'"))),
@@ -232,6 +230,27 @@ impl Reader<'_> {
             }
         }
         Ok(out)
+    }
+
+    /// An inline mesh `o` with the maps `textures` needs `TexCoordData` when one of them samples an image
+    /// at the surface's (u, v): without pairs every point would take the texel at (0, 0), one colour over
+    /// the whole mesh. (A short `TexCoordData` is refused where a corner's id falls outside it.)
+    pub(super) fn check_uvs_for_images(&self, o: &Node, name: &str, textures: &[usize]) -> Result<()> {
+        if !self.uvs.is_empty() {
+            return Ok(());
+        }
+        let image = textures
+            .iter()
+            .map(|&t| &self.desc.textures[t])
+            .find(|t| matches!(t.source, TextureSource::Image { .. }) && t.decal != DecalMode::ReplaceBackground);
+        let Some(t) = image else { return Ok(()) };
+        let at = o.child("Textures").or_else(|| o.child("Texture")).unwrap_or(o);
+        let msg = format!(
+            "{name}: image texture '{}' needs texture coordinates, but TexCoordData has no (u, v) pairs (every \
+             point would show the texel at (0, 0))",
+            t.id
+        );
+        Err(self.err(at, msg))
     }
 
     /// `TexCoordData`: (u, v) pairs, numbered from 1 like the vertices.

@@ -27,13 +27,18 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+mod probe;
+use probe::camera_sample;
+pub use probe::{back_face_share, inspect_sample, BACK_FACE_WARNING_SHARE};
+
 use crate::accum::SampleSum;
+use crate::camera::Camera;
 use crate::error::Result;
 use crate::film::{out_of_memory, Film};
 use crate::integrator::debug::{heatmap_finish, overlay_boxes, BOX_COLOR};
-use crate::integrator::{DebugIntegrator, DebugView, Integrator, RayLog};
+use crate::integrator::{thread_time, DebugIntegrator, DebugView, Integrator, RayLog};
 use crate::renderer::Renderer;
-use crate::sampler::{SampleStream, SamplerKind, Strata};
+use crate::sampler::{SamplerKind, Strata};
 use crate::scene::Scene;
 
 const TILE: u32 = 16;
@@ -46,7 +51,8 @@ const BATCH: usize = 256;
 pub struct RenderOptions {
     /// Samples per pixel, overriding the camera's `NumSamples`.
     pub spp: Option<u32>,
-    /// Cull back faces for camera rays; `None` follows the scene (which defaults to no culling).
+    /// Cull back faces for camera rays; `None` follows the scene ([`Scene::cull_backfaces`]: its
+    /// `BackfaceCulling`, else its form's default), and no culling when it makes no choice.
     pub cull_backfaces: Option<bool>,
     /// Render a debug view instead of (or over) the Whitted image.
     pub debug: Option<DebugView>,
@@ -65,6 +71,9 @@ pub struct RenderOptions {
     pub seed: u64,
     /// How the path tracer's random numbers are spread over a pixel's samples.
     pub sampler: SamplerKind,
+    /// The heatmap view's colours run up to this cost instead of the image's own maximum (to show two
+    /// structures' heatmaps on one scale).
+    pub heatmap_scale: Option<u32>,
 }
 
 /// What a render measured.
@@ -72,10 +81,11 @@ pub struct RenderOptions {
 pub struct RenderStats {
     /// Rays traced: camera, shadow and secondary.
     pub rays: u64,
-    /// The time the structure's queries took, summed over threads (estimated from a sample of them:
-    /// [`RayLog`]).
+    /// The time the structure's queries took, summed over threads (estimated from a sample of them,
+    /// each tile's capped at its CPU time: [`RayLog`]).
     pub traversal: Duration,
-    /// The time the workers spent on tiles, summed over threads.
+    /// The CPU time the workers spent on tiles, summed over threads: not the time they waited for a
+    /// core, nor for work.
     pub busy: Duration,
     /// Wall time.
     pub time: Duration,
@@ -87,6 +97,9 @@ pub struct RenderStats {
     pub heatmap_max: Option<u32>,
     /// The render was cancelled before it finished: the film is incomplete.
     pub cancelled: bool,
+    /// Camera samples whose Whitted ray tree reached its budget and dropped the rest
+    /// ([`crate::integrator::TREE_BUDGET`]).
+    pub capped_samples: u64,
 }
 
 impl RenderStats {
@@ -95,8 +108,9 @@ impl RenderStats {
         self.rays as f64 / self.time.as_secs_f64().max(1e-9) / 1e6
     }
 
-    /// The share of the workers' time spent in the structure's queries (the rest is shading, sampling
-    /// and the render loop), or `None` when nothing was traced.
+    /// The share of the workers' CPU time on tiles spent in the structure's queries (the rest is
+    /// shading, sampling and the render loop), or `None` when nothing was traced. Other programs that
+    /// take the cores change it little ([`RayLog`]: within a few points on a loaded 2-core machine).
     pub fn traversal_share(&self) -> Option<f64> {
         (self.busy > Duration::ZERO && self.traversal > Duration::ZERO)
             .then(|| (self.traversal.as_secs_f64() / self.busy.as_secs_f64()).min(1.0))
@@ -112,11 +126,21 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Film, RenderStats)> {
-    let cam = &scene.cameras[camera];
+    render_camera(scene, &scene.cameras[camera], opts, progress)
+}
+
+/// [`render`] through any camera of the scene's, such as one a live view moved
+/// ([`Camera::posed`]).
+pub fn render_camera(
+    scene: &Scene,
+    cam: &Camera,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Film, RenderStats)> {
     let (w, h) = (cam.width, cam.height);
     // Tiles land in a full-frame film (debug overlays are drawn in frame coordinates), cut at the end.
     let mut film = Film::try_new(w, h)?;
-    let (traced, stats, scale) = trace(scene, camera, opts, progress)?;
+    let (traced, stats, scale) = trace(scene, cam, opts, progress)?;
     let count = stats.samples.1 - stats.samples.0;
     for ((x0, y0, tw), sums, _, _) in traced {
         for (k, s) in sums.into_iter().enumerate() {
@@ -125,7 +149,7 @@ pub fn render(
         }
     }
     let heatmap_max = match opts.debug {
-        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film)),
+        Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film, opts.heatmap_scale)),
         Some(DebugView::Boxes { depth }) => {
             overlay_boxes(&mut film, cam, &scene.geometry.boxes_at_depth(depth), BOX_COLOR);
             None
@@ -170,7 +194,7 @@ pub fn render_sums(
     let ww = (window.2 - window.0) as usize;
     let mut sums = sums_buffer(window)?;
     sums.resize(ww * (window.3 - window.1) as usize, SampleSum::default());
-    let (traced, stats, scale) = trace(scene, camera, &opts, progress)?;
+    let (traced, stats, scale) = trace(scene, cam, &opts, progress)?;
     for ((x0, y0, tw), tile, _, _) in traced {
         for (k, s) in tile.into_iter().enumerate() {
             let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
@@ -195,18 +219,17 @@ fn sums_buffer(window: (u32, u32, u32, u32)) -> Result<Vec<SampleSum>> {
 /// Bytes of one pixel's exact sample sums.
 const SUM_BYTES: u64 = std::mem::size_of::<SampleSum>() as u64;
 
-/// Per-tile sums over the crop window: `((x0, y0, tile width), sums, the tile's rays, its time)`, the stats
+/// Per-tile sums over the crop window: `((x0, y0, tile width), sums, the tile's rays, its CPU time)`, the stats
 /// and the radiance scale.
 type Traced = Vec<((u32, u32, u32), Vec<SampleSum>, RayLog, Duration)>;
 
 fn trace(
     scene: &Scene,
-    camera: usize,
+    cam: &Camera,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Traced, RenderStats, f32)> {
     let start = Instant::now();
-    let cam = &scene.cameras[camera];
     let cull = opts.cull_backfaces.or(scene.cull_backfaces).unwrap_or(false);
     let integrator = Integrator::new(scene, cam, opts.renderer.unwrap_or(cam.renderer), cull);
     // Views that do not shade trace the pixel centre once: their values do not average meaningfully.
@@ -237,8 +260,10 @@ fn trace(
             // Every tile's sums are kept until the image is assembled: together, one per pixel.
             let mut pixels =
                 sums_buffer((x0, y0, x1, y1)).map_err(|_| out_of_memory(cx1 - cx0, cy1 - cy0, total * SUM_BYTES))?;
-            let tile_start = Instant::now();
-            let mut log = RayLog::default();
+            let tile_start = thread_time();
+            // A phase per tile (a hash of its place), so that small tiles' queries get timed too.
+            let mut log =
+                RayLog::with_phase((x0 / TILE).wrapping_mul(0x9E37_79B1) ^ (y0 / TILE).wrapping_mul(0x85EB_CA6B));
             let tile: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
@@ -249,13 +274,7 @@ fn trace(
                 streams.clear();
                 for &(x, y) in group {
                     for k in k0..k1 {
-                        let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
-                        let offset = strata.offset(k, &mut sample.rng);
-                        let mut ray = cam.ray(x, y, offset, sample.rng.next_2d());
-                        // A time is drawn only when something moves, so still scenes keep their streams.
-                        if moving {
-                            ray = ray.with_time(sample.rng.next_f32());
-                        }
+                        let (ray, sample) = camera_sample(cam, opts, strata, moving, (x, y, k));
                         batch.push(match &debug {
                             Some(_) => ray,
                             None => integrator.camera_ray(&ray),
@@ -283,26 +302,28 @@ fn trace(
             }
             let n = done.fetch_add(pixels.len() as u64, Ordering::Relaxed) + pixels.len() as u64;
             progress(n, total);
-            Ok(((x0, y0, x1 - x0), pixels, log, tile_start.elapsed()))
+            Ok(((x0, y0, x1 - x0), pixels, log, thread_time().saturating_sub(tile_start)))
         })
         .collect();
     let traced = traced?;
     let cancelled = is_cancelled();
-    let mut log = RayLog::default();
-    let mut busy = Duration::ZERO;
-    for (_, _, l, t) in &traced {
-        log.merge(l);
-        busy += *t;
+    let (mut rays, mut traversal, mut busy, mut capped_samples) = (0, Duration::ZERO, Duration::ZERO, 0);
+    for (_, _, log, cpu) in &traced {
+        rays += log.rays;
+        capped_samples += log.capped_samples;
+        traversal += log.traversal_within(*cpu);
+        busy += *cpu;
     }
     let stats = RenderStats {
-        rays: log.rays,
-        traversal: log.traversal(),
+        rays,
+        traversal,
         busy,
         time: start.elapsed(),
         spp,
         samples: (k0, k1),
         heatmap_max: None,
         cancelled,
+        capped_samples,
     };
     Ok((traced, stats, scale))
 }
@@ -328,4 +349,55 @@ fn cut(film: &Film, x0: u32, y0: u32, x1: u32, y1: u32) -> Film {
         out.pixels[dst..dst + out.width as usize].copy_from_slice(&film.pixels[row + x0 as usize..row + x1 as usize]);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::AccelConfig;
+    use crate::scene::parse_desc;
+
+    /// A 24x16 view of two walls meeting at x = 0, the left one wound `left`, the right one `right`
+    /// (`1 2 3 1 3 4`: facing the camera; `1 3 2 1 4 3`: its back to it).
+    fn walls(left: &str, right: &str) -> Scene {
+        let text = format!(
+            r#"<Scene>
+                <Cameras><Camera id="1">
+                    <Position>0 0 5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up><NearPlane>-1 1 -1 1</NearPlane>
+                    <NearDistance>2</NearDistance><ImageResolution>24 16</ImageResolution><ImageName>w.png</ImageName>
+                </Camera></Cameras>
+                <Materials><Material id="1">
+                    <AmbientReflectance>1 1 1</AmbientReflectance><DiffuseReflectance>1 1 1</DiffuseReflectance>
+                </Material></Materials>
+                <VertexData>-10 -10 0  0 -10 0  0 10 0  -10 10 0  10 -10 0  10 10 0</VertexData>
+                <Objects>
+                    <Mesh id="1"><Material>1</Material><Faces>{left}</Faces></Mesh>
+                    <Mesh id="2"><Material>1</Material><Faces>{right}</Faces></Mesh>
+                </Objects>
+            </Scene>"#
+        );
+        let desc = parse_desc(&text, std::path::Path::new("walls.xml")).unwrap();
+        Scene::build(desc, &AccelConfig::default(), None).unwrap()
+    }
+
+    #[test]
+    fn back_face_share_counts_the_camera_rays_whose_first_hit_culling_would_skip() {
+        let (front, back) = ("1 2 3 1 3 4", "1 3 2 1 4 3");
+        // The right wall is the left one moved by 10 in x (vertices 2 5 6 3 for 1 2 3 4).
+        let (right_front, right_back) = ("2 5 6 2 6 3", "2 6 5 2 3 6");
+        assert_eq!(back_face_share(&walls(front, right_front), 0), 0.0);
+        assert_eq!(back_face_share(&walls(back, right_back), 0), 1.0);
+        // Half the image: not "most" of it.
+        let half = back_face_share(&walls(back, right_front), 0);
+        assert_eq!(half, 0.5);
+        assert!(half <= BACK_FACE_WARNING_SHARE);
+    }
+
+    #[test]
+    fn render_stats_traversal_is_within_the_tiles_cpu_time() {
+        let scene = walls("1 2 3 1 3 4", "2 5 6 2 6 3");
+        let (_, stats) = render(&scene, 0, &RenderOptions { spp: Some(16), ..Default::default() }, &|_, _| {}).unwrap();
+        assert!(stats.traversal > Duration::ZERO && stats.traversal <= stats.busy, "{stats:?}");
+        assert!(stats.traversal_share().is_some_and(|s| s > 0.0 && s <= 1.0));
+    }
 }

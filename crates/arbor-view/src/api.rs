@@ -1,0 +1,492 @@
+//! The routes (`docs/view.md` lists them with their bodies and answers) and the checks every request
+//! passes first: the `Host` header names this server (a web page on another name cannot reach it through
+//! DNS rebinding), and the token is there, as `?token=` or an `X-Arbor-Token` header (a local user or a
+//! page that does not know it can do nothing). Bodies are JSON of at most [`MAX_BODY`] bytes; a bad
+//! request is a 4xx with `{"error": "..."}`, never a panic. Heavy requests (inspecting a pixel, the
+//! side-by-side heatmaps) take one of [`HEAVY`] slots or get 503; event streams one of [`STREAMS`].
+
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use arbor::accel::{AccelConfig, AccelKind};
+use arbor::integrator::DebugView;
+use arbor::render::{render_camera, RenderOptions};
+use axum::body::{Body, Bytes};
+use axum::extract::{DefaultBodyLimit, Query, Request, State};
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::middleware::{self, Next};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use axum::response::{Html, IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::Router;
+use futures_util::StreamExt;
+use serde_json::{json, Value};
+use tokio::sync::{broadcast, Semaphore};
+
+use crate::bench::Bench;
+use crate::frames::{Frames, Image};
+use crate::json::{camera_json, view_request, MAX_SIDE, MAX_SPP};
+use crate::structures::{label, stats_json, Structures};
+use crate::ViewConfig;
+
+/// The largest request body, in bytes.
+pub const MAX_BODY: usize = 16 * 1024;
+/// Heavy requests at once.
+pub const HEAVY: usize = 2;
+/// Event streams open at once.
+pub const STREAMS: usize = 8;
+/// The longest a request waits for a new image.
+const LONGEST_WAIT: Duration = Duration::from_secs(20);
+
+/// The page: HTML with its style and script inlined, so that one request (with the token) brings all.
+const PAGE: &str = concat!(
+    include_str!("page/head.html"),
+    "<style>\n",
+    include_str!("page/app.css"),
+    "</style>\n",
+    include_str!("page/body.html"),
+    "<script>\n",
+    include_str!("page/app.js"),
+    "</script>\n</body>\n</html>\n"
+);
+
+struct App {
+    structures: Arc<Structures>,
+    frames: Arc<Frames>,
+    bench: Arc<Bench>,
+    events: broadcast::Sender<String>,
+    token: String,
+    hosts: Vec<String>,
+    heavy: Arc<Semaphore>,
+    streams: Arc<Semaphore>,
+    compared: Mutex<HashMap<String, Arc<Image>>>,
+}
+
+type Shared = Arc<App>;
+
+/// An error answer: a status and a message.
+pub struct ApiError(StatusCode, String);
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let mut r = (self.0, json!({ "error": self.1 }).to_string()).into_response();
+        r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
+        r
+    }
+}
+
+fn bad(msg: impl Into<String>) -> ApiError {
+    ApiError(StatusCode::BAD_REQUEST, msg.into())
+}
+
+fn ok_json(v: Value) -> Response {
+    ([(header::CONTENT_TYPE, "application/json"), (header::CACHE_CONTROL, "no-store")], v.to_string()).into_response()
+}
+
+/// A running `arbor view` server.
+pub struct Server {
+    addr: SocketAddr,
+    token: String,
+    runtime: Option<tokio::runtime::Runtime>,
+    stop: Option<tokio::sync::oneshot::Sender<()>>,
+}
+
+impl Server {
+    /// Builds the scene, binds `config.addr` and starts serving in the background.
+    pub fn start(config: ViewConfig) -> Result<Server, arbor::Error> {
+        let token = match config.token {
+            Some(t) => t,
+            None => crate::random_token().map_err(|e| arbor::Error::Invalid(format!("cannot draw a token: {e}")))?,
+        };
+        let (events, _) = broadcast::channel(256);
+        let structures = Arc::new(Structures::new(config.desc, config.accel, events.clone())?);
+        let frames = Frames::start(structures.clone(), events.clone());
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(2)
+            .max_blocking_threads(HEAVY + 2)
+            .enable_all()
+            .build()
+            .map_err(|e| arbor::Error::Invalid(format!("cannot start the server: {e}")))?;
+        let listener = runtime
+            .block_on(tokio::net::TcpListener::bind(config.addr))
+            .map_err(|e| arbor::Error::Invalid(format!("cannot listen on {}: {e}", config.addr)))?;
+        let addr = listener.local_addr().map_err(|e| arbor::Error::Invalid(e.to_string()))?;
+        let hosts = allowed_hosts(addr);
+        let app = Arc::new(App {
+            structures,
+            frames,
+            bench: Arc::new(Bench::default()),
+            events,
+            token: token.clone(),
+            hosts,
+            heavy: Arc::new(Semaphore::new(HEAVY)),
+            streams: Arc::new(Semaphore::new(STREAMS)),
+            compared: Mutex::new(HashMap::new()),
+        });
+        let router = routes(app);
+        let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+        runtime.spawn(async move {
+            let serve = axum::serve(crate::listener::Limited::new(listener), router);
+            let _ = serve
+                .with_graceful_shutdown(async move {
+                    let _ = stopped.await;
+                })
+                .await;
+        });
+        Ok(Server { addr, token, runtime: Some(runtime), stop: Some(stop) })
+    }
+
+    /// The address it listens on.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// The token every request needs.
+    pub fn token(&self) -> &str {
+        &self.token
+    }
+
+    /// The URL to open: the page, with its token.
+    pub fn url(&self) -> String {
+        format!("http://{}/?token={}", self.addr, self.token)
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        if let Some(stop) = self.stop.take() {
+            let _ = stop.send(());
+        }
+        if let Some(rt) = self.runtime.take() {
+            rt.shutdown_timeout(Duration::from_secs(1));
+        }
+    }
+}
+
+/// The `Host` values a request may carry: the address served, and for loopback `localhost` too.
+fn allowed_hosts(addr: SocketAddr) -> Vec<String> {
+    let port = addr.port();
+    let mut hosts = vec![addr.to_string()];
+    if addr.ip().is_loopback() {
+        hosts.extend([format!("localhost:{port}"), format!("127.0.0.1:{port}"), format!("[::1]:{port}")]);
+    }
+    hosts
+}
+
+fn routes(app: Shared) -> Router {
+    Router::new()
+        .route("/", get(page))
+        .route("/api/scene", get(scene))
+        .route("/api/view", post(set_view))
+        .route("/api/image", get(image))
+        .route("/api/events", get(events))
+        .route("/api/inspect", get(inspect))
+        .route("/api/accel", post(rebuild))
+        .route("/api/compare", get(compare))
+        .route("/api/compare/image", get(compare_image))
+        .route("/api/bench", get(bench_state).post(bench_start))
+        .fallback(|| async { ApiError(StatusCode::NOT_FOUND, "no such page or endpoint".into()) })
+        .layer(middleware::from_fn_with_state(app.clone(), guard))
+        .layer(DefaultBodyLimit::max(MAX_BODY))
+        .with_state(app)
+}
+
+/// The checks before any route: the host, then the token.
+async fn guard(State(app): State<Shared>, request: Request, next: Next) -> Response {
+    let host = request.headers().get(header::HOST).and_then(|h| h.to_str().ok()).unwrap_or("");
+    if !app.hosts.iter().any(|h| h == host) {
+        return ApiError(StatusCode::FORBIDDEN, format!("host '{host}' is not this server")).into_response();
+    }
+    let query = request.uri().query().unwrap_or("");
+    let from_query = query.split('&').find_map(|kv| kv.strip_prefix("token="));
+    let from_header = request.headers().get("x-arbor-token").and_then(|h| h.to_str().ok());
+    let given = from_header.or(from_query).unwrap_or("");
+    if !same(given.as_bytes(), app.token.as_bytes()) {
+        return ApiError(StatusCode::FORBIDDEN, "a valid token is required (open the URL arbor view printed)".into())
+            .into_response();
+    }
+    next.run(request).await
+}
+
+/// Equality in time that does not depend on where the strings differ.
+fn same(a: &[u8], b: &[u8]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).fold(0u8, |acc, (x, y)| acc | (x ^ y)) == 0
+}
+
+async fn page() -> Response {
+    let mut r = Html(PAGE).into_response();
+    r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    r
+}
+
+async fn scene(State(app): State<Shared>) -> Response {
+    let s = app.structures.scene();
+    let desc = app.structures.desc();
+    let kinds: Vec<Value> = AccelKind::ALL
+        .iter()
+        .map(|&k| {
+            let config = AccelConfig::from(k);
+            let params: Vec<Value> = config
+                .params()
+                .iter()
+                .map(|p| {
+                    json!({"key": p.key, "about": p.about, "range": p.range.to_string(),
+                    "default": config.get(p.key).map(|v| v.to_string())})
+                })
+                .collect();
+            json!({"kind": k.name(), "params": params})
+        })
+        .collect();
+    let config = app.structures.config();
+    let params: serde_json::Map<String, Value> = config
+        .params()
+        .iter()
+        .filter_map(|p| config.get(p.key).map(|v| (p.key.to_string(), json!(v.to_string()))))
+        .collect();
+    ok_json(json!({
+        "scene": desc.source.display().to_string(),
+        "cameras": s.cameras.iter().enumerate().map(|(i, c)| camera_json(i, c)).collect::<Vec<_>>(),
+        "bounds": {"min": crate::json::vec3(s.geometry.bounds().min), "max": crate::json::vec3(s.geometry.bounds().max)},
+        "structure": {"label": label(&config), "kind": config.kind().name(), "params": params, "stats": stats_json(&s),
+            "building": app.structures.building()},
+        "kinds": kinds,
+        "limits": {"max_side": MAX_SIDE, "max_spp": MAX_SPP},
+        "view": app.frames.current().map(|(v, _)| v),
+    }))
+}
+
+/// Reads a JSON body.
+fn body_json(body: &Bytes) -> Result<Value, ApiError> {
+    serde_json::from_slice(body).map_err(|e| bad(format!("the body is not JSON: {e}")))
+}
+
+async fn set_view(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
+    let request = view_request(&body_json(&body)?, &app.structures.scene()).map_err(bad)?;
+    let view = app.frames.set_view(request);
+    Ok(ok_json(json!({ "view": view })))
+}
+
+/// A whole number from the query.
+fn number(q: &HashMap<String, String>, key: &str) -> Result<Option<u64>, ApiError> {
+    q.get(key)
+        .map(|v| v.parse::<u64>().map_err(|_| bad(format!("'{key}' must be a whole number, not '{v}'"))))
+        .transpose()
+}
+
+/// The last image of a channel newer than `after`, waiting for one up to `wait` ms (at most 20 s):
+/// 8-bit RGB with its size and figures in headers, or 204 when none came.
+async fn image(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
+    let channel = match q.get("channel").map(String::as_str) {
+        None | Some("render") => &app.frames.render,
+        Some("overlay") => &app.frames.overlay,
+        Some(other) => return Err(bad(format!("'channel' must be render or overlay, not '{other}'"))),
+    };
+    let after = number(&q, "after")?.unwrap_or(0);
+    let wait = Duration::from_millis(number(&q, "wait")?.unwrap_or(LONGEST_WAIT.as_millis() as u64)).min(LONGEST_WAIT);
+    let mut rx = channel.subscribe();
+    let newer = |rx: &tokio::sync::watch::Receiver<Option<Arc<Image>>>| rx.borrow().clone().filter(|i| i.seq > after);
+    let found = match newer(&rx) {
+        Some(i) => Some(i),
+        None => tokio::time::timeout(wait, async {
+            loop {
+                if rx.changed().await.is_err() {
+                    return None;
+                }
+                if let Some(i) = newer(&rx) {
+                    return Some(i);
+                }
+            }
+        })
+        .await
+        .ok()
+        .flatten(),
+    };
+    Ok(match found {
+        Some(i) => image_response(&i),
+        None => StatusCode::NO_CONTENT.into_response(),
+    })
+}
+
+fn image_response(i: &Image) -> Response {
+    let mut r = Response::new(Body::from(i.rgb.clone()));
+    let h = r.headers_mut();
+    let mut put = |k: &'static str, v: String| {
+        if let Ok(v) = HeaderValue::from_str(&v) {
+            h.insert(k, v);
+        }
+    };
+    put("content-type", "application/octet-stream".into());
+    put("cache-control", "no-store".into());
+    put("x-seq", i.seq.to_string());
+    put("x-view", i.view.to_string());
+    put("x-width", i.width.to_string());
+    put("x-height", i.height.to_string());
+    put("x-samples", i.samples.to_string());
+    put("x-render-ms", format!("{:.3}", i.render_ms));
+    put("x-mrays", format!("{:.3}", i.mrays));
+    put("x-convert-ms", format!("{:.3}", i.convert_ms));
+    if let Some(m) = i.heatmap_max {
+        put("x-heatmap-max", m.to_string());
+    }
+    r
+}
+
+/// Server-Sent Events: every notification as JSON, starting with `{"type": "hello"}`.
+async fn events(State(app): State<Shared>) -> Result<Response, ApiError> {
+    let permit = app
+        .streams
+        .clone()
+        .try_acquire_owned()
+        .map_err(|_| ApiError(StatusCode::SERVICE_UNAVAILABLE, "too many event streams open".into()))?;
+    let rx = app.events.subscribe();
+    let hello = futures_util::stream::once(async {
+        Ok::<_, std::convert::Infallible>(Event::default().data(r#"{"type":"hello"}"#))
+    });
+    let stream = tokio_stream::wrappers::BroadcastStream::new(rx).filter_map(move |m| {
+        let _held = &permit;
+        // A listener too slow to keep up skips what it missed.
+        std::future::ready(m.ok().map(|text| Ok(Event::default().data(text))))
+    });
+    Ok(Sse::new(hello.chain(stream)).keep_alive(KeepAlive::default()).into_response())
+}
+
+/// Runs `work` on a blocking thread if a heavy slot is free.
+async fn heavy<T: Send + 'static>(app: &Shared, work: impl FnOnce() -> T + Send + 'static) -> Result<T, ApiError> {
+    let _permit = app
+        .heavy
+        .clone()
+        .try_acquire_owned()
+        .map_err(|_| ApiError(StatusCode::SERVICE_UNAVAILABLE, "busy: try again".into()))?;
+    tokio::task::spawn_blocking(work).await.map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
+}
+
+async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
+    let (x, y) = (
+        number(&q, "x")?.ok_or_else(|| bad("'x' is required"))?,
+        number(&q, "y")?.ok_or_else(|| bad("'y' is required"))?,
+    );
+    let (_, view) = app
+        .frames
+        .current()
+        .ok_or_else(|| ApiError(StatusCode::CONFLICT, "no view yet: POST /api/view first".into()))?;
+    if x >= view.width as u64 || y >= view.height as u64 {
+        return Err(bad(format!("pixel ({x}, {y}) is outside the {}x{} view", view.width, view.height)));
+    }
+    let structures = app.structures.clone();
+    let v = heavy(&app, move || crate::inspect::inspect(&structures, &view, x as u32, y as u32)).await?;
+    Ok(ok_json(v))
+}
+
+async fn rebuild(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
+    let body = body_json(&body)?;
+    let kind =
+        body.get("kind").and_then(Value::as_str).ok_or_else(|| bad("\"kind\" (a structure name) is required"))?;
+    let kind: AccelKind = kind.parse().map_err(|e| bad(format!("\"kind\": {e}")))?;
+    let mut config = AccelConfig::from(kind);
+    if let Some(params) = body.get("params") {
+        let Value::Object(params) = params else { return Err(bad("\"params\" must be an object of key: value")) };
+        for (key, value) in params {
+            let text = match value {
+                Value::String(s) => s.clone(),
+                Value::Number(n) => n.to_string(),
+                _ => return Err(bad(format!("parameter '{key}' must be a number or a word"))),
+            };
+            config.set(key, &text).map_err(|e| bad(e.to_string()))?;
+        }
+    }
+    let frames = app.frames.clone();
+    if !app.structures.rebuild(config.clone(), move || frames.restart()) {
+        return Err(ApiError(StatusCode::CONFLICT, "a rebuild is running".into()));
+    }
+    Ok((
+        StatusCode::ACCEPTED,
+        [(header::CONTENT_TYPE, "application/json")],
+        json!({"building": label(&config)}).to_string(),
+    )
+        .into_response())
+}
+
+/// Heatmaps of two structures through the current view on one colour scale (the larger maximum).
+async fn compare(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
+    let kind = |key: &str| -> Result<AccelKind, ApiError> {
+        q.get(key)
+            .ok_or_else(|| bad(format!("'{key}' (a structure name) is required")))?
+            .parse()
+            .map_err(|e| bad(format!("'{key}': {e}")))
+    };
+    let (a, b) = (kind("a")?, kind("b")?);
+    let (_, view) = app
+        .frames
+        .current()
+        .ok_or_else(|| ApiError(StatusCode::CONFLICT, "no view yet: POST /api/view first".into()))?;
+    let worker = app.clone();
+    let result = heavy(&app, move || -> arbor::Result<Value> {
+        let mut out = Vec::new();
+        for kind in [a, b] {
+            let scene = worker.structures.with_kind(kind)?;
+            let cam = scene.cameras[view.camera].posed(view.eye, view.gaze, view.up, view.width, view.height);
+            out.push((kind, scene, cam));
+        }
+        let heat = |scene: &arbor::scene::Scene, cam: &arbor::camera::Camera, scale: Option<u32>| {
+            let opts = RenderOptions { debug: Some(DebugView::Heatmap), heatmap_scale: scale, ..Default::default() };
+            render_camera(scene, cam, &opts, &|_, _| {})
+        };
+        let maxima = out
+            .iter()
+            .map(|(_, s, c)| heat(s, c, None).map(|r| r.1.heatmap_max.unwrap_or(0)))
+            .collect::<arbor::Result<Vec<_>>>()?;
+        let scale = maxima.iter().copied().max().unwrap_or(0).max(1);
+        let mut rows = Vec::new();
+        for ((kind, scene, cam), max) in out.iter().zip(maxima) {
+            let (film, stats) = heat(scene, cam, Some(scale))?;
+            let image = Image {
+                seq: 0,
+                view: 0,
+                width: film.width,
+                height: film.height,
+                rgb: film.to_rgb8(),
+                samples: 1,
+                render_ms: stats.time.as_secs_f64() * 1e3,
+                mrays: stats.mrays_per_s(),
+                convert_ms: 0.0,
+                heatmap_max: Some(max),
+            };
+            worker.compared.lock().unwrap_or_else(|e| e.into_inner()).insert(kind.name().to_string(), Arc::new(image));
+            rows.push(json!({"kind": kind.name(), "max": max, "stats": stats_json(scene)}));
+        }
+        Ok(json!({"scale": scale, "structures": rows}))
+    })
+    .await?
+    .map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))?;
+    Ok(ok_json(result))
+}
+
+async fn compare_image(
+    State(app): State<Shared>,
+    Query(q): Query<HashMap<String, String>>,
+) -> Result<Response, ApiError> {
+    let kind = q.get("kind").ok_or_else(|| bad("'kind' is required"))?;
+    let image = app.compared.lock().unwrap_or_else(|e| e.into_inner()).get(kind).cloned();
+    image
+        .map(|i| image_response(&i))
+        .ok_or_else(|| ApiError(StatusCode::NOT_FOUND, format!("no heatmap of '{kind}': GET /api/compare first")))
+}
+
+async fn bench_state(State(app): State<Shared>) -> Response {
+    ok_json(app.bench.json())
+}
+
+async fn bench_start(State(app): State<Shared>) -> Result<Response, ApiError> {
+    let (_, view) = app
+        .frames
+        .current()
+        .ok_or_else(|| ApiError(StatusCode::CONFLICT, "no view yet: POST /api/view first".into()))?;
+    let scene = app.structures.scene();
+    let cam = scene.cameras[view.camera].posed(view.eye, view.gaze, view.up, view.width, view.height);
+    if !app.bench.start(app.structures.clone(), cam, app.events.clone()) {
+        return Err(ApiError(StatusCode::CONFLICT, "the benchmark is running".into()));
+    }
+    Ok((StatusCode::ACCEPTED, [(header::CONTENT_TYPE, "application/json")], r#"{"state":"running"}"#).into_response())
+}
