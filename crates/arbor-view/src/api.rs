@@ -363,14 +363,20 @@ async fn events(State(app): State<Shared>) -> Result<Response, ApiError> {
     Ok(Sse::new(hello.chain(stream)).keep_alive(KeepAlive::default()).into_response())
 }
 
-/// Runs `work` on a blocking thread if a heavy slot is free.
+/// Runs `work` on a blocking thread if a heavy slot is free. The work holds the slot until it ends: a
+/// client that goes away drops the request, not the work, which must not make room for more.
 async fn heavy<T: Send + 'static>(app: &Shared, work: impl FnOnce() -> T + Send + 'static) -> Result<T, ApiError> {
-    let _permit = app
+    let permit = app
         .heavy
         .clone()
         .try_acquire_owned()
         .map_err(|_| ApiError(StatusCode::SERVICE_UNAVAILABLE, "busy: try again".into()))?;
-    tokio::task::spawn_blocking(work).await.map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
+    tokio::task::spawn_blocking(move || {
+        let _held = permit;
+        work()
+    })
+    .await
+    .map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
 }
 
 async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
