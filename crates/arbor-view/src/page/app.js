@@ -371,7 +371,9 @@ function listen() {
   events.onmessage = async (m) => {
     const e = JSON.parse(m.data);
     if (e.type === "build") {
-      if (e.state === "running") $("build-status").textContent = `building ${e.kind} (${e.purpose}): ${(e.elapsed_ms / 1000).toFixed(1)} s`;
+      // The structures built for a comparison or the benchmark have their own status lines there:
+      // this one is the current structure's, and keeps its last word until the next rebuild.
+      if (e.state === "running" && e.purpose === "current") $("build-status").textContent = `building ${e.kind}: ${(e.elapsed_ms / 1000).toFixed(1)} s`;
       if (e.state === "failed") $("build-status").textContent = `build of ${e.kind} failed: ${e.error}`;
       if (e.state === "done") { showStats(e.stats, false); $("build-status").textContent = `built ${e.kind} in ${e.stats.build_ms.toFixed(1)} ms`; }
     } else if (e.type === "bench") {
