@@ -95,7 +95,9 @@ async function requestView() {
     status(`view refused: ${e.message}`);
   }
   state.sending = false;
-  if (state.dirty) { state.dirty = false; requestView(); }
+  if (state.dirty) { state.dirty = false; requestView(); return; }
+  // The view the server is on, once no other is on its way (for the browser test, with data-view).
+  $("view").dataset.asked = String(state.view);
 }
 
 function status(text) { $("status").textContent = text; }
@@ -137,6 +139,7 @@ async function follow(channel) {
           `${f.mrays.toFixed(2)} Mrays/s · server ${f.convert.toFixed(1)} ms · view ${state.view}`);
         $("view").dataset.samples = String(f.samples);
         $("view").dataset.seq = String(f.seq);
+        $("view").dataset.view = h("x-view");
       } else {
         const max = h("x-heatmap-max");
         $("heatmap-legend").hidden = max === null;

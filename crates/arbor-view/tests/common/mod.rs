@@ -260,10 +260,13 @@ impl Events {
         }
     }
 
-    /// Events up to and including the first for which `done` holds.
+    /// Events up to and including the first for which `done` holds (within the hang guard: events
+    /// that keep coming without it fail the test too).
     pub fn until(&mut self, done: impl Fn(&Value) -> bool) -> Vec<Value> {
         let mut seen = Vec::new();
+        let start = std::time::Instant::now();
         loop {
+            assert!(start.elapsed() < HANG_GUARD, "the awaited event did not come within the hang guard");
             let e = self.next();
             let stop = done(&e);
             seen.push(e);
