@@ -83,6 +83,7 @@ function overlayValue() {
 async function requestView() {
   if (state.sending) { state.dirty = true; return; }
   state.sending = true;
+  delete $("view").dataset.asked;
   try {
     const body = {
       camera: state.camera, eye: state.eye, gaze: state.gaze, up: state.up,
@@ -96,7 +97,8 @@ async function requestView() {
   }
   state.sending = false;
   if (state.dirty) { state.dirty = false; requestView(); return; }
-  // The view the server is on, once no other is on its way (for the browser test, with data-view).
+  // The view the server is on, once no other is on its way; absent while one is (for the browser
+  // test, with data-view: the page shows what it last asked for when both are equal).
   $("view").dataset.asked = String(state.view);
 }
 
