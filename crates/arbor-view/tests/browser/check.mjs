@@ -62,8 +62,9 @@ async function run(page) {
   await page.waitForSelector("#stats tbody tr", { timeout: WAIT });
 
   // One sample: the page's first full frame is then `arbor render --spp 1` of the scene's camera.
+  // Typed, then committed by leaving the field (as a user does): its one change event.
   await page.locator("#spp").fill("1");
-  await page.locator("#spp").dispatchEvent("change");
+  await page.locator("#spp").blur();
   const first = await settled(page, 0);
   const firstPixels = await canvasRgb(page);
   const firstReceived = received.get(`${first.view}/1`);
