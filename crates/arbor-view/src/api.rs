@@ -14,6 +14,7 @@ use arbor::accel::{AccelConfig, AccelKind};
 use arbor::integrator::DebugView;
 use arbor::render::{render_camera, RenderOptions};
 use axum::body::{Body, Bytes};
+use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Query, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -188,6 +189,10 @@ fn routes(app: Shared) -> Router {
         .route("/api/compare/image", get(compare_image))
         .route("/api/bench", get(bench_state).post(bench_start))
         .fallback(|| async { ApiError(StatusCode::NOT_FOUND, "no such page or endpoint".into()) })
+        // The router adds the `Allow` header.
+        .method_not_allowed_fallback(|method: axum::http::Method, uri: axum::http::Uri| async move {
+            ApiError(StatusCode::METHOD_NOT_ALLOWED, format!("{method} is not allowed on {}", uri.path()))
+        })
         .layer(middleware::from_fn_with_state(app.clone(), guard))
         .layer(DefaultBodyLimit::max(MAX_BODY))
         .with_state(app)
@@ -257,13 +262,19 @@ async fn scene(State(app): State<Shared>) -> Response {
     }))
 }
 
-/// Reads a JSON body.
-fn body_json(body: &Bytes) -> Result<Value, ApiError> {
-    serde_json::from_slice(body).map_err(|e| bad(format!("the body is not JSON: {e}")))
+/// Reads a JSON body: at most [`MAX_BODY`] bytes (413 beyond), well framed (400 if not), JSON.
+fn body_json(body: Result<Bytes, BytesRejection>) -> Result<Value, ApiError> {
+    let body = body.map_err(|e| match e.status() {
+        StatusCode::PAYLOAD_TOO_LARGE => {
+            ApiError(StatusCode::PAYLOAD_TOO_LARGE, format!("the body is larger than {MAX_BODY} bytes"))
+        }
+        status => ApiError(status, format!("the body could not be read: {}", e.body_text())),
+    })?;
+    serde_json::from_slice(&body).map_err(|e| bad(format!("the body is not JSON: {e}")))
 }
 
-async fn set_view(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
-    let request = view_request(&body_json(&body)?, &app.structures.scene()).map_err(bad)?;
+async fn set_view(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
+    let request = view_request(&body_json(body)?, &app.structures.scene()).map_err(bad)?;
     let view = app.frames.set_view(request);
     Ok(ok_json(json!({ "view": view })))
 }
@@ -352,14 +363,20 @@ async fn events(State(app): State<Shared>) -> Result<Response, ApiError> {
     Ok(Sse::new(hello.chain(stream)).keep_alive(KeepAlive::default()).into_response())
 }
 
-/// Runs `work` on a blocking thread if a heavy slot is free.
+/// Runs `work` on a blocking thread if a heavy slot is free. The work holds the slot until it ends: a
+/// client that goes away drops the request, not the work, which must not make room for more.
 async fn heavy<T: Send + 'static>(app: &Shared, work: impl FnOnce() -> T + Send + 'static) -> Result<T, ApiError> {
-    let _permit = app
+    let permit = app
         .heavy
         .clone()
         .try_acquire_owned()
         .map_err(|_| ApiError(StatusCode::SERVICE_UNAVAILABLE, "busy: try again".into()))?;
-    tokio::task::spawn_blocking(work).await.map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
+    tokio::task::spawn_blocking(move || {
+        let _held = permit;
+        work()
+    })
+    .await
+    .map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
 }
 
 async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
@@ -379,8 +396,8 @@ async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, Stri
     Ok(ok_json(v))
 }
 
-async fn rebuild(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
-    let body = body_json(&body)?;
+async fn rebuild(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
+    let body = body_json(body)?;
     let kind =
         body.get("kind").and_then(Value::as_str).ok_or_else(|| bad("\"kind\" (a structure name) is required"))?;
     let kind: AccelKind = kind.parse().map_err(|e| bad(format!("\"kind\": {e}")))?;
