@@ -264,7 +264,8 @@ impl Mesh {
     /// occluded(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> ndarray
     ///
     /// Whether each ray hits anything in ``(t_min, t_max)``: (N,) bool. An any-hit query (it stops
-    /// at the first triangle found), not a closest hit. Arguments as for ``intersect``.
+    /// at the first triangle found), not a closest hit. Arguments as for ``intersect``: origins and
+    /// directions (N, 3) float32/float64, ``t`` in units of each direction's length.
     #[pyo3(signature = (origins, directions, t_min=None, t_max=None, *, threads=None))]
     fn occluded<'py>(
         &self,
@@ -284,7 +285,8 @@ impl Mesh {
 
     /// intersect_all(origins, directions, t_min=0.0, t_max=inf, *, max_hits=None, threads=None) -> dict
     ///
-    /// Every surface crossing of each ray in ``(t_min, t_max)``, in order of ``t``, at most
+    /// Every surface crossing of each ray (origins and directions (N, 3), t_min and t_max numbers or
+    /// (N,) arrays, as for ``intersect``) in ``(t_min, t_max)``, in order of ``t``, at most
     /// ``max_hits`` per ray (the closest; None: all). A ray through an edge or a vertex shared by
     /// several triangles crosses the surface once there and is reported once (README: the tie
     /// rule). Returns a dict of flat arrays, one entry per crossing, in ray order: ``ray`` and
@@ -320,8 +322,8 @@ impl Mesh {
 
     /// count_crossings(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> ndarray
     ///
-    /// The number of surface crossings of each ray in ``(t_min, t_max)``, (N,) int64: the rows
-    /// ``intersect_all`` would return for it, without a cap.
+    /// The number of surface crossings of each ray (origins and directions (N, 3)) in
+    /// ``(t_min, t_max)``, (N,) int64: the rows ``intersect_all`` would return for it, without a cap.
     #[pyo3(signature = (origins, directions, t_min=None, t_max=None, *, threads=None))]
     fn count_crossings<'py>(
         &self,

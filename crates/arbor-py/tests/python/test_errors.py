@@ -115,3 +115,25 @@ def test_the_gil_is_released_during_a_query():
     # Holding the GIL, the query would leave the other thread at most the one switch interval
     # before it started.
     assert during >= 20, f"the other thread ran {during} times during the query"
+
+
+def test_help_shows_shapes_dtypes_and_units_and_the_stubs_name_what_exists():
+    import ast
+    import pathlib
+
+    for f in (ar.Mesh.intersect, ar.Mesh.intersect_all, ar.Mesh.occluded, ar.Mesh.contains, ar.render):
+        doc = f.__doc__
+        assert "(N, 3)" in doc or "(H, W, 3)" in doc, f.__name__
+        assert "float32" in doc or "bool" in doc, f.__name__
+    assert "units of" in ar.Mesh.intersect.__doc__
+    stub = pathlib.Path(ar.__file__).with_name("_native.pyi")
+    if not stub.exists():  # an installed wheel keeps its stubs beside the package
+        stub = pathlib.Path(__file__).parents[2] / "python" / "arbor_rays" / "_native.pyi"
+    tree = ast.parse(stub.read_text())
+    names = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    assert names == {"Mesh", "load_mesh", "accel_kinds", "render"}
+    methods = {n.name for n in next(n for n in tree.body if getattr(n, "name", "") == "Mesh").body if isinstance(n, ast.FunctionDef)}
+    for m in methods - {"__init__"}:
+        assert hasattr(ar.Mesh, m), m
+    for m in ("intersect", "occluded", "intersect_all", "count_crossings", "contains", "build", "stats"):
+        assert m in methods, m
