@@ -225,30 +225,20 @@ pub fn triangles(faces: &Ints<'_>, vertices: usize) -> PyResult<Vec<[u32; 3]>> {
             Ok(idx as u32)
         }
     };
-    let mut out = Vec::new();
     match faces {
-        Ints::Signed(a) => {
-            let a = a.as_array();
-            out.reserve(a.nrows());
-            for i in 0..a.nrows() {
-                out.push([
-                    read(i, 0, a[[i, 0]] as i128)?,
-                    read(i, 1, a[[i, 1]] as i128)?,
-                    read(i, 2, a[[i, 2]] as i128)?,
-                ]);
-            }
-        }
-        Ints::Unsigned(a) => {
-            let a = a.as_array();
-            out.reserve(a.nrows());
-            for i in 0..a.nrows() {
-                out.push([
-                    read(i, 0, a[[i, 0]] as i128)?,
-                    read(i, 1, a[[i, 1]] as i128)?,
-                    read(i, 2, a[[i, 2]] as i128)?,
-                ]);
-            }
-        }
+        Ints::Signed(a) => rows_of(a.as_array(), read),
+        Ints::Unsigned(a) => rows_of(a.as_array(), read),
+    }
+}
+
+/// The rows of `a`, each index read by `read(row, column, value)`.
+fn rows_of<T: Copy + Into<i128>>(
+    a: ArrayView2<'_, T>,
+    read: impl Fn(usize, usize, i128) -> PyResult<u32>,
+) -> PyResult<Vec<[u32; 3]>> {
+    let mut out = Vec::with_capacity(a.nrows());
+    for i in 0..a.nrows() {
+        out.push([read(i, 0, a[[i, 0]].into())?, read(i, 1, a[[i, 1]].into())?, read(i, 2, a[[i, 2]].into())?]);
     }
     Ok(out)
 }

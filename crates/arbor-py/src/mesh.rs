@@ -137,6 +137,40 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// `query` on the closest-hit structure, with the GIL released, on `threads` threads.
+    fn on_main<R: Send>(
+        &self,
+        py: Python<'_>,
+        threads: Option<usize>,
+        query: impl FnOnce(&Structure) -> R + Send,
+    ) -> PyResult<R> {
+        let b = self.built(py, threads)?;
+        Ok(py.detach(|| in_pool(threads, || query(&b.main))))
+    }
+
+    /// `query` on the collecting structure (`crossings.rs`), with the GIL released.
+    fn on_collector<R: Send>(
+        &self,
+        py: Python<'_>,
+        threads: Option<usize>,
+        query: impl FnOnce(&Structure<Collector>) -> R + Send,
+    ) -> PyResult<R> {
+        let b = self.collector(py, threads)?;
+        let Some(s) = b.collect.get() else { unreachable!("collector() builds it") };
+        Ok(py.detach(|| in_pool(threads, || query(s))))
+    }
+}
+
+/// A dict of the given items.
+fn dict<'py>(py: Python<'py>, items: Vec<(&str, Bound<'py, PyAny>)>) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in items {
+        d.set_item(k, v)?;
+    }
+    Ok(d)
+}
+
 fn check_threads(threads: Option<usize>) -> PyResult<Option<usize>> {
     match threads {
         Some(0) => Err(PyValueError::new_err("threads must be at least 1 (None uses every core)")),
@@ -248,17 +282,19 @@ impl Mesh {
     ) -> PyResult<Bound<'py, PyDict>> {
         let threads = check_threads(threads)?;
         let args = RayArgs::read(origins, directions, t_min, t_max)?;
-        let b = self.built(py, threads)?;
         let rays = args.set();
-        let c = py.detach(|| in_pool(threads, || queries::closest(&b.main, rays)));
-        let d = PyDict::new(py);
-        d.set_item("t", c.t.into_pyarray(py))?;
-        d.set_item("triangle", c.triangle.into_pyarray(py))?;
-        d.set_item("u", c.u.into_pyarray(py))?;
-        d.set_item("v", c.v.into_pyarray(py))?;
-        d.set_item("normal", vec3s(py, c.normal)?)?;
-        d.set_item("point", vec3s(py, c.point)?)?;
-        Ok(d)
+        let c = self.on_main(py, threads, |s| queries::closest(s, rays))?;
+        dict(
+            py,
+            vec![
+                ("t", c.t.into_pyarray(py).into_any()),
+                ("triangle", c.triangle.into_pyarray(py).into_any()),
+                ("u", c.u.into_pyarray(py).into_any()),
+                ("v", c.v.into_pyarray(py).into_any()),
+                ("normal", vec3s(py, c.normal)?),
+                ("point", vec3s(py, c.point)?),
+            ],
+        )
     }
 
     /// occluded(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> ndarray
@@ -278,9 +314,8 @@ impl Mesh {
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let threads = check_threads(threads)?;
         let args = RayArgs::read(origins, directions, t_min, t_max)?;
-        let b = self.built(py, threads)?;
         let rays = args.set();
-        Ok(py.detach(|| in_pool(threads, || queries::occluded(&b.main, rays))).into_pyarray(py))
+        Ok(self.on_main(py, threads, |s| queries::occluded(s, rays))?.into_pyarray(py))
     }
 
     /// intersect_all(origins, directions, t_min=0.0, t_max=inf, *, max_hits=None, threads=None) -> dict
@@ -305,19 +340,20 @@ impl Mesh {
     ) -> PyResult<Bound<'py, PyDict>> {
         let threads = check_threads(threads)?;
         let args = RayArgs::read(origins, directions, t_min, t_max)?;
-        let b = self.collector(py, threads)?;
         let rays = args.set();
         let cap = max_hits.unwrap_or(usize::MAX);
-        let Some(s) = b.collect.get() else { unreachable!("collector() builds it") };
-        let a = py.detach(|| in_pool(threads, || queries::all_hits(s, rays, cap)));
-        let d = PyDict::new(py);
-        d.set_item("ray", a.ray.into_pyarray(py))?;
-        d.set_item("triangle", a.triangle.into_pyarray(py))?;
-        d.set_item("t", a.t.into_pyarray(py))?;
-        d.set_item("u", a.u.into_pyarray(py))?;
-        d.set_item("v", a.v.into_pyarray(py))?;
-        d.set_item("point", vec3s(py, a.point)?)?;
-        Ok(d)
+        let a = self.on_collector(py, threads, |s| queries::all_hits(s, rays, cap))?;
+        dict(
+            py,
+            vec![
+                ("ray", a.ray.into_pyarray(py).into_any()),
+                ("triangle", a.triangle.into_pyarray(py).into_any()),
+                ("t", a.t.into_pyarray(py).into_any()),
+                ("u", a.u.into_pyarray(py).into_any()),
+                ("v", a.v.into_pyarray(py).into_any()),
+                ("point", vec3s(py, a.point)?),
+            ],
+        )
     }
 
     /// count_crossings(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> ndarray
@@ -336,10 +372,8 @@ impl Mesh {
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let threads = check_threads(threads)?;
         let args = RayArgs::read(origins, directions, t_min, t_max)?;
-        let b = self.collector(py, threads)?;
         let rays = args.set();
-        let Some(s) = b.collect.get() else { unreachable!("collector() builds it") };
-        Ok(py.detach(|| in_pool(threads, || queries::count_crossings(s, rays))).into_pyarray(py))
+        Ok(self.on_collector(py, threads, |s| queries::count_crossings(s, rays))?.into_pyarray(py))
     }
 
     /// contains(points, *, threads=None) -> ndarray
@@ -356,10 +390,8 @@ impl Mesh {
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let threads = check_threads(threads)?;
         let p = floats_n3("points", points)?;
-        let b = self.collector(py, threads)?;
         let rows = p.rows();
-        let Some(s) = b.collect.get() else { unreachable!("collector() builds it") };
-        Ok(py.detach(|| in_pool(threads, || queries::contains_points(s, rows))).into_pyarray(py))
+        Ok(self.on_collector(py, threads, |s| queries::contains_points(s, rows))?.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {
