@@ -6,7 +6,6 @@
 //! side-by-side heatmaps) take one of [`HEAVY`] slots or get 503; event streams one of [`STREAMS`].
 
 use std::collections::HashMap;
-use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -30,7 +29,6 @@ use crate::bench::Bench;
 use crate::frames::{Frames, Image};
 use crate::json::{camera_json, view_request, MAX_SIDE, MAX_SPP};
 use crate::structures::{label, stats_json, Structures};
-use crate::ViewConfig;
 
 /// The largest request body, in bytes.
 pub const MAX_BODY: usize = 16 * 1024;
@@ -53,19 +51,20 @@ const PAGE: &str = concat!(
     "</script>\n</body>\n</html>\n"
 );
 
-struct App {
-    structures: Arc<Structures>,
-    frames: Arc<Frames>,
-    bench: Arc<Bench>,
-    events: broadcast::Sender<String>,
-    token: String,
-    hosts: Vec<String>,
-    heavy: Arc<Semaphore>,
-    streams: Arc<Semaphore>,
-    compared: Mutex<HashMap<String, Arc<Image>>>,
+/// What every route shares.
+pub(crate) struct App {
+    pub(crate) structures: Arc<Structures>,
+    pub(crate) frames: Arc<Frames>,
+    pub(crate) bench: Arc<Bench>,
+    pub(crate) events: broadcast::Sender<String>,
+    pub(crate) token: String,
+    pub(crate) hosts: Vec<String>,
+    pub(crate) heavy: Arc<Semaphore>,
+    pub(crate) streams: Arc<Semaphore>,
+    pub(crate) compared: Mutex<HashMap<String, Arc<Image>>>,
 }
 
-type Shared = Arc<App>;
+pub(crate) type Shared = Arc<App>;
 
 /// An error answer: a status and a message.
 pub struct ApiError(StatusCode, String);
@@ -86,97 +85,8 @@ fn ok_json(v: Value) -> Response {
     ([(header::CONTENT_TYPE, "application/json"), (header::CACHE_CONTROL, "no-store")], v.to_string()).into_response()
 }
 
-/// A running `arbor view` server.
-pub struct Server {
-    addr: SocketAddr,
-    token: String,
-    runtime: Option<tokio::runtime::Runtime>,
-    stop: Option<tokio::sync::oneshot::Sender<()>>,
-}
-
-impl Server {
-    /// Builds the scene, binds `config.addr` and starts serving in the background.
-    pub fn start(config: ViewConfig) -> Result<Server, arbor::Error> {
-        let token = match config.token {
-            Some(t) => t,
-            None => crate::random_token().map_err(|e| arbor::Error::Invalid(format!("cannot draw a token: {e}")))?,
-        };
-        let (events, _) = broadcast::channel(256);
-        let structures = Arc::new(Structures::new(config.desc, config.accel, events.clone())?);
-        let frames = Frames::start(structures.clone(), events.clone());
-        let runtime = tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(2)
-            .max_blocking_threads(HEAVY + 2)
-            .enable_all()
-            .build()
-            .map_err(|e| arbor::Error::Invalid(format!("cannot start the server: {e}")))?;
-        let listener = runtime
-            .block_on(tokio::net::TcpListener::bind(config.addr))
-            .map_err(|e| arbor::Error::Invalid(format!("cannot listen on {}: {e}", config.addr)))?;
-        let addr = listener.local_addr().map_err(|e| arbor::Error::Invalid(e.to_string()))?;
-        let hosts = allowed_hosts(addr);
-        let app = Arc::new(App {
-            structures,
-            frames,
-            bench: Arc::new(Bench::default()),
-            events,
-            token: token.clone(),
-            hosts,
-            heavy: Arc::new(Semaphore::new(HEAVY)),
-            streams: Arc::new(Semaphore::new(STREAMS)),
-            compared: Mutex::new(HashMap::new()),
-        });
-        let router = routes(app);
-        let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
-        runtime.spawn(async move {
-            let serve = axum::serve(crate::listener::Limited::new(listener), router);
-            let _ = serve
-                .with_graceful_shutdown(async move {
-                    let _ = stopped.await;
-                })
-                .await;
-        });
-        Ok(Server { addr, token, runtime: Some(runtime), stop: Some(stop) })
-    }
-
-    /// The address it listens on.
-    pub fn addr(&self) -> SocketAddr {
-        self.addr
-    }
-
-    /// The token every request needs.
-    pub fn token(&self) -> &str {
-        &self.token
-    }
-
-    /// The URL to open: the page, with its token.
-    pub fn url(&self) -> String {
-        format!("http://{}/?token={}", self.addr, self.token)
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        if let Some(stop) = self.stop.take() {
-            let _ = stop.send(());
-        }
-        if let Some(rt) = self.runtime.take() {
-            rt.shutdown_timeout(Duration::from_secs(1));
-        }
-    }
-}
-
-/// The `Host` values a request may carry: the address served, and for loopback `localhost` too.
-fn allowed_hosts(addr: SocketAddr) -> Vec<String> {
-    let port = addr.port();
-    let mut hosts = vec![addr.to_string()];
-    if addr.ip().is_loopback() {
-        hosts.extend([format!("localhost:{port}"), format!("127.0.0.1:{port}"), format!("[::1]:{port}")]);
-    }
-    hosts
-}
-
-fn routes(app: Shared) -> Router {
+/// Every route, behind the host and token checks.
+pub(crate) fn routes(app: Shared) -> Router {
     Router::new()
         .route("/", get(page))
         .route("/api/scene", get(scene))
