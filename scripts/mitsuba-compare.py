@@ -29,7 +29,11 @@ emitter (one-sided, on the side the triangle winding faces), a `PointLight` a `p
 MaxRecursionDepth D is Mitsuba max_depth D + 2 unless --max-depth is given (it changes Mitsuba only):
 Mitsuba counts the camera ray as segment 1, the course's renderers recurse D times after the primary
 hit and connect each hit to a light, and D + 2 is what matches the official hw6 path-traced images.
-Russian roulette is off (rr_depth = max_depth). Mitsuba's sampler is `independent` (its default)
+Russian roulette is off (rr_depth = max_depth), unless Arbor's camera has one (`roulette` in
+--arbor-path-options, or a camera naming RussianRoulette rendered with the scene's RendererParams): Arbor
+then runs its unbiased roulette (`--roulette unbiased`: the course's, which a camera's RussianRoulette
+otherwise gets, is biased) with no depth limit but its cap of 256 bounces, and Mitsuba its own roulette
+(rr_depth 5) with max_depth 258, the same estimand. Mitsuba's sampler is `independent` (its default)
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
 path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default (`stratified`) stratifies
 its light and bounce samples too, `--arbor-sampler independent` only the pixel position. Anything else
@@ -59,6 +63,8 @@ import mitsuba as mi  # noqa: E402
 
 # The variant used for references, official-image checks and reading EXR files.
 REF_VARIANT = "llvm_ad_rgb"
+# Arbor's cap on the bounces of a path under Russian roulette (integrator/path.rs MAX_BOUNCES).
+ARBOR_MAX_BOUNCES = 256
 
 
 class Unsupported(Exception):
@@ -170,14 +176,29 @@ def read_camera(root, camera_id):
         if not (math.isclose(left, -right) and math.isclose(bottom, -top)):
             raise Unsupported("an off-centre <NearPlane> window is not translated")
         fov_y = math.degrees(2 * math.atan(top / child_floats(cam, "NearDistance")[0]))
+    path_traced = (cam.findtext("Renderer") or "").strip() == "PathTracing"
+    params = (cam.findtext("RendererParams") or "").split() if path_traced else []
     return {"id": cam.get("id").strip(), "position": pos, "gaze": gaze, "up": np.array(child_floats(cam, "Up")),
-            "fov_y": fov_y, "width": width, "height": height,
+            "fov_y": fov_y, "width": width, "height": height, "path_traced": path_traced,
+            "roulette": "RussianRoulette" in params,
             "left_handed": (cam.get("handedness") or "right").strip() == "left",
             "image_name": cam.find("ImageName").text.strip()}
 
 
-def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent"):
-    """(Mitsuba scene dict, camera, max_depth, notes) for `path` (call with a variant set); PLY files go to tmp."""
+def arbor_roulette(path, camera_id, args):
+    """Whether Arbor's render of the camera ends its paths by Russian roulette (the unbiased one: the script
+    passes --roulette unbiased), as --arbor-integrator and --arbor-path-options make it."""
+    if args.arbor_integrator and args.arbor_path_options:
+        return "roulette" in args.arbor_path_options.split(",")
+    if args.arbor_integrator not in ("", "path"):
+        return False
+    return read_camera(ET.parse(path).getroot(), camera_id)["roulette"]
+
+
+def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent", roulette=False):
+    """(Mitsuba scene dict, camera, max_depth, notes) for `path` (call with a variant set); PLY files go to tmp.
+    With `roulette`, Mitsuba's own Russian roulette and Arbor's cap on path length, as Arbor's unbiased
+    roulette has them."""
     notes = []
     root = ET.parse(path).getroot()
     if any(child_floats(root, "BackgroundColor", [0.0])):
@@ -190,7 +211,8 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent")
     transforms = read_transforms(root)
     materials = {m.get("id").strip(): m for m in root.findall("Materials/Material")}
     if max_depth is None:
-        max_depth = int(root.findtext("MaxRecursionDepth", "0")) + 2
+        max_depth = ARBOR_MAX_BOUNCES + 2 if roulette else int(root.findtext("MaxRecursionDepth", "0")) + 2
+    rr_depth = 5 if roulette else max_depth
 
     to_world = mi.ScalarTransform4f().look_at(origin=cam["position"].tolist(),
                                               target=(cam["position"] + cam["gaze"]).tolist(),
@@ -199,7 +221,7 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent")
         to_world = to_world @ mi.ScalarTransform4f().scale([-1, 1, 1])
     scene = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": max_depth, "hide_emitters": False},
+        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr_depth, "hide_emitters": False},
         "sensor": {"type": "perspective", "fov_axis": "y", "fov": cam["fov_y"], "to_world": to_world,
                    "sampler": {"type": sampler, "sample_count": spp},
                    "film": {"type": "hdrfilm", "width": cam["width"], "height": cam["height"],
@@ -254,17 +276,17 @@ def shape_of(obj, verts, transforms, ply_path):
 # Rendering
 
 
-def load_scene(path, camera_id, spp, max_depth, sampler="independent"):
+def load_scene(path, camera_id, spp, max_depth, sampler="independent", roulette=False):
     with tempfile.TemporaryDirectory() as tmp:
-        desc, cam, depth, notes = metu_to_mitsuba(path, camera_id, spp, max_depth, Path(tmp), sampler)
+        desc, cam, depth, notes = metu_to_mitsuba(path, camera_id, spp, max_depth, Path(tmp), sampler, roulette)
         return mi.load_dict(desc), cam, depth, notes
 
 
-def render_mitsuba(variant, path, camera_id, spp, threads, max_depth, seed=0, sampler="independent"):
+def render_mitsuba(variant, path, camera_id, spp, threads, max_depth, seed=0, sampler="independent", roulette=False):
     """(image, seconds of mi.render) in `variant`; the LLVM variant renders once first to compile."""
     mi.set_variant(variant)
     dr.set_thread_count(threads)
-    scene, _, _, _ = load_scene(path, camera_id, spp, max_depth, sampler)
+    scene, _, _, _ = load_scene(path, camera_id, spp, max_depth, sampler, roulette)
     runs = 2 if variant.startswith("llvm") else 1
     for _ in range(runs):
         start = time.perf_counter()
@@ -284,14 +306,17 @@ def arbor_missing(arbor, integrator, path_options):
         return f"`{arbor} render --help` has no --integrator option (no path tracer yet)"
     if path_options and "--path-options" not in help_text:
         return f"`{arbor} render --help` has no --path-options option (pass --arbor-path-options '')"
+    if "--roulette" not in help_text:
+        return f"`{arbor} render --help` has no --roulette option (a build before Arbor had two roulettes)"
     return None
 
 
 def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0, sampler=None):
     """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed."""
     stats = Path(str(out) + ".stats.json")
+    # The unbiased roulette for a camera with one (a camera's RussianRoulette is otherwise the course's).
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
-           "--seed", str(seed), "-o", str(out), "--no-warnings", "--stats-json", str(stats)]
+           "--seed", str(seed), "-o", str(out), "--no-warnings", "--stats-json", str(stats), "--roulette", "unbiased"]
     if integrator:
         cmd += ["--integrator", integrator]
     if integrator and path_options:
@@ -338,7 +363,8 @@ def references(args, path, camera_id, tag, arbor_ok):
     mitsuba_file = args.cache / f"{tag}_mitsuba_{args.ref_spp}spp.exr"
     if not mitsuba_file.exists():
         print(f"  rendering the Mitsuba reference ({args.ref_spp} spp) ...", flush=True)
-        img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1)
+        img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1,
+                                roulette=args.roulette)
         write_exr(mitsuba_file, img)
     refs["Mitsuba"] = read_exr(mitsuba_file)
     # "radiance": Arbor's EXRs hold radiance in the scene's units (older caches held it times 1/255).
@@ -360,15 +386,17 @@ def compare_scene(args, spec, arbor_ok):
     print(f"{path.name}{':' + camera_id if camera_id else ''}", flush=True)
     mi.set_variant(REF_VARIANT)
     try:
-        _, cam, depth, notes = load_scene(path, camera_id or None, args.spp, args.max_depth)
+        args.roulette = arbor_roulette(path, camera_id or None, args)
+        _, cam, depth, notes = load_scene(path, camera_id or None, args.spp, args.max_depth, roulette=args.roulette)
     except Unsupported as e:
         print(f"  skipped: {e}")
         return []
     for note in notes:
         print(f"  note: {note}")
     camera_id = cam["id"]
-    tag = f"{path.stem}_cam{camera_id}_d{depth}"
-    print(f"  camera {camera_id}, {cam['width']}x{cam['height']}, Mitsuba max_depth {depth}", flush=True)
+    tag = f"{path.stem}_cam{camera_id}_d{depth}{'_rr' if args.roulette else ''}"
+    roulette = ", Russian roulette (Arbor's unbiased one, Mitsuba's)" if args.roulette else ""
+    print(f"  camera {camera_id}, {cam['width']}x{cam['height']}, Mitsuba max_depth {depth}{roulette}", flush=True)
     refs = references(args, path, camera_id, tag, arbor_ok)
     official = path.parent.parent / "outputs" / cam["image_name"]
     if official.exists():
@@ -381,7 +409,8 @@ def compare_scene(args, spec, arbor_ok):
     rows = []
     sampler = args.mitsuba_sampler
     renderers = [(v if sampler == "independent" else f"{v} ({sampler})",
-                  lambda t, v=v: render_mitsuba(v, path, camera_id, args.spp, t, args.max_depth, sampler=sampler))
+                  lambda t, v=v: render_mitsuba(v, path, camera_id, args.spp, t, args.max_depth, sampler=sampler,
+                                                roulette=args.roulette))
                  for v in args.variants]
     if arbor_ok:
         out = args.cache / f"{tag}_arbor_run.exr"

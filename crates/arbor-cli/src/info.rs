@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use arbor::accel::{AccelConfig, AccelKind};
+use arbor::renderer::{PathOptions, Renderer, Roulette};
 use arbor::scene::{BrdfDesc, BrdfKind, LightDesc, MaterialKind, MeshSource, Scene, ShapeDesc};
 use clap::Args;
 
@@ -26,6 +27,27 @@ pub struct InfoArgs {
     /// (as `arbor render --no-limits`).
     #[arg(long)]
     pub no_limits: bool,
+}
+
+/// A path-traced camera's options as `arbor info` lists them, its roulette spelt out.
+fn describe_path_tracer(o: PathOptions) -> String {
+    let mut words = vec!["path tracing"];
+    for (on, word) in
+        [(o.importance_sampling, "importance sampling"), (o.next_event, "next event estimation"), (o.mis, "MIS")]
+    {
+        if on {
+            words.push(word);
+        }
+    }
+    let roulette = match o.roulette {
+        Roulette::Off => "paths end at MaxRecursionDepth",
+        Roulette::Course => {
+            "the course's Russian roulette (biased: brighter than the converged answer; --roulette unbiased for \
+             Arbor's)"
+        }
+        Roulette::Unbiased => "Arbor's unbiased Russian roulette",
+    };
+    format!("{}; {roulette}", words.join(", "))
 }
 
 /// Runs `arbor info`.
@@ -61,6 +83,9 @@ pub fn run(args: InfoArgs) -> Result<(), Failure> {
             c.image_name,
             if c.orthographic { "  (orthographic)" } else { "" }
         );
+        if let Renderer::PathTracing(o) = c.renderer {
+            say!("  renderer {}", describe_path_tracer(o));
+        }
         if let Some(t) = &c.tonemap {
             say!(
                 "  tonemap  {:?}  key {}  burn {}%  saturation {}  gamma {}",

@@ -269,6 +269,11 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
         let cam = &scene.cameras[c];
         let spp = args.spp.unwrap_or(cam.num_samples).max(1);
         let renderer = args.integrator.renderer(cam.renderer).map_err(Failure::Usage)?;
+        if args.quiet < 2 && !args.no_warnings {
+            if let Some(w) = args.integrator.roulette_unused(cam.renderer, &cam.id) {
+                eprintln!("warning: {w}");
+            }
+        }
         let base = RenderOptions { renderer, ..base.clone() };
         // A debug view is written as it is.
         let tonemap = if args.debug.is_some() { None } else { cam.tonemap };

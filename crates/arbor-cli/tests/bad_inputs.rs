@@ -200,6 +200,8 @@ fn catalogue() -> Vec<Row> {
     render("no_camera.xml", 3, "error: no_camera.xml: the scene has no camera\n"),
     render("empty_scene.xml", 3, "error: empty_scene.xml: the scene has no camera\n"),
     render("no_objects.xml", 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\n"),
+    // --roulette picks the roulette of cameras that have one: a camera without says so.
+    cmd(&["render", "no_objects.xml", "--roulette", "course", "-o", "OUT"], 0, "warning: no_objects.xml: the scene has no objects: every image shows only the background\nwarning: --roulette course: camera 1 has no Russian roulette, its paths end at MaxRecursionDepth (a path-traced camera gets one from RussianRoulette or --path-options roulette)\n"),
     // A path tracer with no light it can take: every object black (the background still shows).
     render("path_tracing_no_light.xml", 0, "warning: path_tracing_no_light.xml:4:9: Camera 1: the path tracer finds no light: the scene has no light, no emitter and no environment map; every object renders black\n"),
     render("path_tracing_point_light_no_nee.xml", 0, "warning: path_tracing_point_light_no_nee.xml:4:9: Camera 1: the path tracer finds no light: without NextEventEstimation it takes no light from point, spot, directional or area lights, and the scene has no emitter or environment map (NextEventEstimation in RendererParams, or --path-options next-event, samples them); every object renders black\n"),

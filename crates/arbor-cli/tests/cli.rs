@@ -131,6 +131,9 @@ fn cli_usage_error_exits_2() {
     assert_eq!(arbor(&["frobnicate"], tmp.path()).status.code(), Some(2));
     assert_eq!(arbor(&["render", "--accel", "quadtree"], tmp.path()).status.code(), Some(2));
     assert_eq!(arbor(&["render", "--path-options", "mis,fast"], tmp.path()).status.code(), Some(2));
+    let o = arbor(&["render", "--roulette", "fair"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("[possible values: course, unbiased]"), "{}", stderr(&o));
     let o = arbor(&["render", "--integrator", "whitted", "--path-options", "mis"], tmp.path());
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--path-options sets the path tracer's options"), "{}", stderr(&o));
@@ -363,6 +366,21 @@ fn cli_info_describes_the_scene() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(out.contains("24x16") && out.contains("sphere") && out.contains("bvh-sah"), "{out}");
+    // Which roulette each path-traced camera gets.
+    let camera = "<ImageName>tiny.png</ImageName><Renderer>PathTracing</Renderer>";
+    let with = |params: &str| TINY.replace("<ImageName>tiny.IMAGE_EXT</ImageName>", &format!("{camera}{params}"));
+    for (params, line) in [
+        ("", "  renderer path tracing; paths end at MaxRecursionDepth\n"),
+        (
+            "<RendererParams>NextEventEstimation RussianRoulette</RendererParams>",
+            "  renderer path tracing, next event estimation; the course's Russian roulette (biased: brighter than \
+             the converged answer; --roulette unbiased for Arbor's)\n",
+        ),
+    ] {
+        let b = write(tmp.path(), "b.xml", &with(params));
+        let o = arbor(&["info", b.to_str().unwrap()], tmp.path());
+        assert!(stdout(&o).contains(line), "{}", stdout(&o));
+    }
 }
 
 #[test]

@@ -20,9 +20,9 @@ pub struct PathOptions {
     /// Lights sampled explicitly at every vertex, and emitters met by a bounce not counted again
     /// (`NextEventEstimation`).
     pub next_event: bool,
-    /// Paths ended at random in proportion to their throughput instead of at the recursion limit
-    /// (`RussianRoulette`).
-    pub russian_roulette: bool,
+    /// How paths end: at the recursion limit, or at random by one of the two Russian roulettes
+    /// ([`Roulette`]; a METU camera's `RussianRoulette` asks for the course's).
+    pub roulette: Roulette,
     /// Light samples and bounce directions both count where they meet an emitter, weighted by the power
     /// heuristic (Veach 1997), instead of discarding the bounce's (`MIS`; implies the two samplings).
     pub mis: bool,
@@ -30,9 +30,9 @@ pub struct PathOptions {
 
 impl PathOptions {
     /// What `--integrator path` uses for a camera that names no renderer: importance sampling, next
-    /// event estimation and multiple importance sampling, Russian roulette after the recursion limit.
+    /// event estimation and multiple importance sampling, paths ended at the recursion limit.
     pub const DEFAULT: PathOptions =
-        PathOptions { importance_sampling: true, next_event: true, russian_roulette: false, mis: true };
+        PathOptions { importance_sampling: true, next_event: true, roulette: Roulette::Off, mis: true };
 
     /// These options with what they imply: MIS weighs light samples against importance-sampled bounces,
     /// so it turns both on.
@@ -43,4 +43,22 @@ impl PathOptions {
             self
         }
     }
+}
+
+/// How the path tracer ends a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Roulette {
+    /// No roulette: a path ends after the scene's `MaxRecursionDepth` bounces.
+    #[default]
+    Off,
+    /// The course's Russian roulette (CENG 795 hw6), what its official images show: at every vertex the
+    /// path survives with probability `q = min(1, max(t))`, `t` the product of the BRDF values met
+    /// before (no cosine, density or earlier `1/q`); a killed vertex keeps its own light (emission and
+    /// light samples) undivided, a surviving one divides it and what follows by `q`. Biased: the
+    /// expectation is `Σ (2 - q_k) E_k` over the path's vertices, `E_k` a vertex's own light
+    /// (weighted by the path's throughput), where an unbiased estimator gives `Σ E_k`.
+    Course,
+    /// Arbor's unbiased Russian roulette: after each bounce the path survives with probability
+    /// `q = min(1, max(beta))` of its throughput `beta` and is divided by `q`.
+    Unbiased,
 }

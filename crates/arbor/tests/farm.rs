@@ -8,7 +8,7 @@ use arbor::accel::AccelConfig;
 use arbor::farm::{merge, read_partial, tile_window, write_partial, Partial};
 use arbor::film::Film;
 use arbor::render::{render, render_sums, RenderOptions};
-use arbor::renderer::{PathOptions, Renderer};
+use arbor::renderer::{PathOptions, Renderer, Roulette};
 use arbor::sampler::SamplerKind;
 use arbor::scene::{parse_desc, Scene, SceneLimits};
 use arbor::tonemap::Tonemap;
@@ -82,8 +82,12 @@ fn farm_path_tracer_sample_ranges_merge_to_the_whole() {
     // them must draw what the whole render draws for the same samples.
     let scene = example();
     let dir = tempfile::tempdir().unwrap();
-    for sampler in [SamplerKind::Stratified, SamplerKind::Independent] {
-        let options = PathOptions { importance_sampling: true, next_event: true, mis: true, ..PathOptions::default() };
+    for (sampler, roulette) in [
+        (SamplerKind::Stratified, Roulette::Off),
+        (SamplerKind::Independent, Roulette::Off),
+        (SamplerKind::Stratified, Roulette::Course),
+    ] {
+        let options = PathOptions { importance_sampling: true, next_event: true, mis: true, roulette };
         let renderer = Some(Renderer::PathTracing(options));
         let base = RenderOptions { renderer, sampler, ..Default::default() };
         let whole = render(&scene, 0, &base, &|_, _| {}).unwrap().0;
@@ -93,7 +97,7 @@ fn farm_path_tracer_sample_ranges_merge_to_the_whole() {
                 .map(|(i, r)| part_with(&scene, dir.path(), Some((i, n)), r, &base))
                 .collect();
             let merged = merge(&parts).unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(bits(&merged), bits(&whole), "{sampler:?}, {n} tiles");
+            assert_eq!(bits(&merged), bits(&whole), "{sampler:?}, {roulette:?}, {n} tiles");
         }
     }
 }

@@ -10,7 +10,7 @@ use arbor::film::Film;
 use arbor::light::environment::EnvMap;
 use arbor::math::Color;
 use arbor::render::{render, RenderOptions};
-use arbor::renderer::{PathOptions, Renderer};
+use arbor::renderer::{PathOptions, Renderer, Roulette};
 use arbor::sampler::SamplerKind;
 use arbor::scene::{parse_desc, Scene};
 
@@ -52,14 +52,14 @@ fn mean(f: &Film) -> f32 {
     f.pixels.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / (3 * f.pixels.len()) as f32
 }
 
-/// Every option combination but MIS (which needs a light to weigh against).
+/// Every option combination but MIS (which needs a light to weigh against), with the unbiased roulette.
 fn option_sets() -> Vec<PathOptions> {
     let mut out = Vec::new();
     for bits in 0..8u32 {
         out.push(PathOptions {
             importance_sampling: bits & 1 != 0,
             next_event: bits & 2 != 0,
-            russian_roulette: bits & 4 != 0,
+            roulette: if bits & 4 != 0 { Roulette::Unbiased } else { Roulette::Off },
             mis: false,
         });
     }
@@ -78,7 +78,7 @@ fn path_white_furnace_gives_back_the_environment_times_the_albedo() {
                 (5..11).flat_map(|y| (5..11).map(move |x| (x, y))).map(|(x, y)| film.pixels[y * 16 + x]).collect();
             let m = centre.iter().map(|c| c.x).sum::<f32>() / centre.len() as f32;
             // Exact but for Russian roulette's and uniform sampling's noise (about 0.01 here).
-            let exact = options.importance_sampling && !options.russian_roulette;
+            let exact = options.importance_sampling && options.roulette == Roulette::Off;
             let tol = if exact { 1e-3 } else { 0.04 };
             assert!((m - kd).abs() < tol, "{options:?}, kd {kd}: centre mean {m}");
             if exact {
@@ -105,7 +105,7 @@ fn path_white_furnace_of_a_mirror_with_a_diffuse_colour_gives_back_both_parts() 
         let px = &film.pixels;
         let centre: Vec<f32> = (5..11).flat_map(|y| (5..11).map(move |x| px[y * 16 + x].x)).collect();
         let m = centre.iter().sum::<f32>() / centre.len() as f32;
-        let exact = options.importance_sampling && !options.russian_roulette;
+        let exact = options.importance_sampling && options.roulette == Roulette::Off;
         let tol = if exact { 1e-3 } else { 0.04 };
         assert!((m - 0.8).abs() < tol, "{options:?}: centre mean {m}");
         if exact {
@@ -186,4 +186,89 @@ fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
         assert!(var_s < 0.8 * var_i, "{what}: stratified variance {var_s} against independent {var_i}");
         assert!((mean_s - mean_i).abs() < 0.02 * mean_i, "{what}: means {mean_s} and {mean_i}");
     }
+}
+
+/// A closed 2x2x2 box seen from its centre looking down at its floor (16x16 pixels, all floor): the five
+/// other faces are one `LightMesh` of radiance `le` facing inwards with diffuse reflectance `walls`, the
+/// floor reflects `floor`, and glows with the walls if `floor` equals `walls`; no other light.
+fn glowing_box(floor: &str, walls: &str, le: f32, depth: u32) -> Scene {
+    let (floor_faces, glowing_floor) = if floor == walls { ("", "1 4 3  1 3 2") } else { ("1 4 3  1 3 2", "") };
+    let xml = format!(
+        r#"<Scene><MaxRecursionDepth>{depth}</MaxRecursionDepth><BackgroundColor>0 0 0</BackgroundColor>
+        <Cameras><Camera id="1"><Position>0 0 0</Position><Gaze>0 -1 0</Gaze><Up>0 0 -1</Up>
+        <NearPlane>-0.4 0.4 -0.4 0.4</NearPlane><NearDistance>1</NearDistance>
+        <ImageResolution>16 16</ImageResolution><ImageName>a.exr</ImageName></Camera></Cameras>
+        <Materials><Material id="1"><AmbientReflectance>0 0 0</AmbientReflectance>
+        <DiffuseReflectance>{floor}</DiffuseReflectance><SpecularReflectance>0 0 0</SpecularReflectance></Material>
+        <Material id="2"><AmbientReflectance>0 0 0</AmbientReflectance><DiffuseReflectance>{walls}</DiffuseReflectance>
+        <SpecularReflectance>0 0 0</SpecularReflectance></Material></Materials>
+        <VertexData>-1 -1 -1  1 -1 -1  1 -1 1  -1 -1 1  -1 1 -1  1 1 -1  1 1 1  -1 1 1</VertexData>
+        <Objects><Mesh id="1"><Material>1</Material><Faces>{floor_faces}</Faces></Mesh>
+        <LightMesh id="1"><Material>2</Material><Radiance>{le} {le} {le}</Radiance>
+        <Faces>{glowing_floor} 5 6 7  5 7 8  1 5 8  1 8 4  2 3 7  2 7 6  1 2 6  1 6 5  4 8 7  4 7 3</Faces>
+        </LightMesh></Objects>
+        </Scene>"#
+    );
+    build(&xml, None)
+}
+
+/// The mean radiance of each channel over the image (the film holds it times the radiance scale).
+fn channel_means(scene: &Scene, f: &Film) -> [f32; 3] {
+    let n = f.pixels.len() as f32;
+    [0, 1, 2].map(|c| f.pixels.iter().map(|p| p.to_array()[c]).sum::<f32>() / n / scene.radiance_scale)
+}
+
+#[test]
+fn path_course_roulette_expects_two_minus_q_times_each_vertex_light() {
+    // One bounce from the floor (reflectance kd, BRDF kd/π) always meets the walls' light Le, and the walls
+    // reflect nothing. The course's roulette: the floor (vertex 0, throughput t = 1) survives surely;
+    // the wall (vertex 1, t = kd/π) with q = max(kd)/π, keeping its emission Le when killed and returning
+    // Le/q when it survives: on average (2 - q) Le. So the pixel's expectation is kd (2 - q) Le, where the
+    // unbiased answer is kd Le. With next event estimation the floor's own light sample is its light
+    // (vertex 0, q = 1: kd Le), the wall's emission met by the bounce is not counted, and the walls have
+    // no BRDF to sample light with: the course's roulette is then unbiased, kd Le.
+    let kd = [0.8f32, 0.4, 0.2];
+    let le = 10.0;
+    let scene = glowing_box("0.8 0.4 0.2", "0 0 0", le, 3);
+    let q = 0.8 / std::f32::consts::PI;
+    for importance_sampling in [true, false] {
+        for next_event in [false, true] {
+            let options = PathOptions { importance_sampling, next_event, roulette: Roulette::Course, mis: false };
+            let got = channel_means(&scene, &path(&scene, options, 64, 1));
+            let gain = if next_event { 1.0 } else { 2.0 - q };
+            for c in 0..3 {
+                let want = kd[c] * gain * le;
+                assert!((got[c] / want - 1.0).abs() < 0.02, "{options:?}: channel {c} {} against {want}", got[c]);
+            }
+        }
+    }
+    // The unbiased roulette and no roulette give kd Le.
+    for roulette in [Roulette::Unbiased, Roulette::Off] {
+        let options = PathOptions { importance_sampling: true, roulette, ..PathOptions::default() };
+        let got = channel_means(&scene, &path(&scene, options, 64, 1));
+        assert!((0..3).all(|c| (got[c] / (kd[c] * le) - 1.0).abs() < 0.02), "{roulette:?}: {got:?}");
+    }
+}
+
+#[test]
+fn path_unbiased_roulette_in_a_glowing_furnace_sums_every_bounce() {
+    // Every face of the box glows Le and reflects kd: radiance Le (1 + kd + kd² + ...) = Le / (1 - kd).
+    // The unbiased roulette has no depth limit (but its cap, where kd^256 is nothing): it converges to
+    // that; without a roulette the path stops after MaxRecursionDepth D bounces, Le (1 - kd^(D+1)) / (1 - kd),
+    // exactly so in each sample with cosine sampling (each bounce weighs exactly kd).
+    let (kd, le, depth) = (0.5f32, 2.0, 3);
+    let scene = glowing_box("0.5 0.5 0.5", "0.5 0.5 0.5", le, depth);
+    for importance_sampling in [true, false] {
+        for next_event in [false, true] {
+            let options = PathOptions { importance_sampling, next_event, roulette: Roulette::Unbiased, mis: false };
+            let got = channel_means(&scene, &path(&scene, options, 64, 1));
+            let want = le / (1.0 - kd);
+            assert!(got.iter().all(|g| (g / want - 1.0).abs() < 0.02), "{options:?}: {got:?} against {want}");
+        }
+    }
+    // (A ray now and then slips out through the box's edges: the image mean, not every pixel.)
+    let options = PathOptions { importance_sampling: true, ..PathOptions::default() };
+    let got = channel_means(&scene, &path(&scene, options, 16, 1));
+    let want = le * (1.0 - kd.powi(depth as i32 + 1)) / (1.0 - kd);
+    assert!(got.iter().all(|g| (g / want - 1.0).abs() < 1e-3), "{got:?} against {want}");
 }

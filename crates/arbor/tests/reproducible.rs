@@ -16,6 +16,7 @@ use std::path::Path;
 use arbor::accel::AccelConfig;
 use arbor::film::Film;
 use arbor::render::{render, RenderOptions};
+use arbor::renderer::{PathOptions, Renderer, Roulette};
 use arbor::scene::{load_desc, parse_desc, Scene, SceneDesc};
 
 const DIVISOR: u32 = 3;
@@ -172,6 +173,19 @@ fn reproducible_example_for_thread_counts_and_crops() {
         }
     }
     assert_eq!(bits(&assembled), bits(&full), "tiles rendered in reverse order");
+}
+
+#[test]
+fn reproducible_course_roulette_for_thread_counts_and_crops() {
+    // The course's roulette draws a number only where a survival is uncertain: still one stream per sample.
+    let scene = example();
+    let options = PathOptions { importance_sampling: true, next_event: true, roulette: Roulette::Course, mis: false };
+    let opts = RenderOptions { renderer: Some(Renderer::PathTracing(options)), spp: Some(4), ..Default::default() };
+    let full = render_on(2, &scene, 0, &opts);
+    assert_eq!(bits(&full), bits(&render_on(1, &scene, 0, &opts)));
+    let crop = (7, 13, 61, 29);
+    let part = render_on(2, &scene, 0, &RenderOptions { crop: Some(crop), ..opts.clone() });
+    assert_eq!(bits(&part), window(&full, crop));
 }
 
 #[test]

@@ -1,16 +1,20 @@
 //! Integrators: what colour a camera ray brings back. [`Integrator`] is the one a camera's image uses.
 
 pub mod debug;
+mod hemisphere;
 pub mod offset;
 mod path;
 mod prune;
 mod ray_log;
+mod roulette;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};
-pub use path::{cosine_hemisphere, uniform_hemisphere, PathTracer, MAX_BOUNCES};
+pub use hemisphere::{cosine_hemisphere, uniform_hemisphere};
+pub use path::PathTracer;
 pub use prune::{Pruning, TreePlan, PRUNED_LEVELS, TREE_BUDGET};
 pub use ray_log::{thread_time, RayEvent, RayLog, TIMED_EVERY};
+pub use roulette::MAX_BOUNCES;
 pub use whitted::Whitted;
 
 use crate::accel::Hit;

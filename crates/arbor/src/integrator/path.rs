@@ -15,28 +15,28 @@
 //!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997). Without
 //!   it, as in the course's plain references, lights no ray can meet give nothing (their radiance matches
 //!   Arbor's within 1% that way). After a delta lobe, met light always counts in full.
-//! - Length: at most `MaxRecursionDepth` bounces; with `RussianRoulette` the course's direct form
-//!   instead: after each bounce the path survives with probability `q = min(1, max(beta))` and is divided
-//!   by it, to a safety cap of [`MAX_BOUNCES`].
+//! - Length: at most `MaxRecursionDepth` bounces, or at random by one of the two Russian roulettes
+//!   ([`super::roulette`]): the course's, biased, which a METU camera's `RussianRoulette` gets, and
+//!   Arbor's unbiased one (`--roulette unbiased`, `--path-options roulette`).
 //!
 //! Materials without a BRDF are shaded as the normalized modified Blinn-Phong model (`k_d/π` plus a
 //! lobe that conserves energy): the course's default Blinn-Phong terms are not a physical BRDF (their
 //! diffuse part reflects π times the light it gets). There is no ambient term. Invariants: every
-//! estimate is unbiased for the options given (the furnace and convergence tests check it); a sample's
-//! value depends only on its random stream.
+//! estimate but the course's roulette is unbiased for the options given (the furnace and convergence
+//! tests check it; the course's roulette's test checks its `Σ (2 - q_k) E_k`); a sample's value depends
+//! only on its random stream.
 
+use super::hemisphere::{cosine_hemisphere, uniform_hemisphere};
 use super::offset::{shadow_ray, spawn_origin};
+use super::roulette::{self, MAX_BOUNCES};
 use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::material::{beer, Brdf, BrdfModel, Material};
-use crate::math::{orthonormal_basis, Color, Ray, Vec2, Vec3};
-use crate::renderer::PathOptions;
+use crate::math::{Color, Ray, Vec2, Vec3};
+use crate::renderer::{PathOptions, Roulette};
 use crate::sampler::SampleStream;
 use crate::scene::{Scene, Surface};
-
-/// The longest path Russian roulette may build (a path through glass keeps its throughput).
-pub const MAX_BOUNCES: u32 = 256;
 
 /// The path tracer for one render.
 pub struct PathTracer<'a> {
@@ -136,7 +136,10 @@ impl<'a> PathTracer<'a> {
         // The last bounce: a delta lobe (or the camera ray) meets light in full; otherwise the point it
         // left from and its direction's density, for the weight of the light it meets.
         let mut last: Option<(Vec3, f32)> = None;
-        let max_bounces = if o.russian_roulette { MAX_BOUNCES } else { scene.max_depth };
+        let max_bounces = if o.roulette == Roulette::Off { scene.max_depth } else { MAX_BOUNCES };
+        let course = o.roulette == Roulette::Course;
+        // The course's roulette's throughput: the product of the BRDF values met so far.
+        let mut t = Color::ONE;
         let mut bounce = 0;
         loop {
             let Some(h) = hit else {
@@ -151,18 +154,25 @@ impl<'a> PathTracer<'a> {
             }
             let mut s = scene.surface(&ray, &h);
             let m = scene.material(&s);
+            // The vertex's own light goes to `l`, or under the course's roulette to `e` first, which the
+            // roulette then weighs.
+            let mut e = Color::ZERO;
+            let own = if course { &mut e } else { &mut l };
             let emitted = scene.emitted(&s, -ray.dir);
             if emitted != Color::ZERO {
                 let w = last.map_or(1.0, |(from, pdf)| {
                     self.met_light_weight(scene.light_of(s.object), from, ray.dir.normalize(), pdf)
                 });
-                l += beta * emitted * w;
+                *own += beta * emitted * w;
             }
             // Only textured objects ask for their textures: the common case builds no shading terms.
             let textured =
                 if scene.has_textures(s.object) { scene.textured(&ray, &h, &mut s, Default::default()) } else { None };
             if let Some(c) = textured.and_then(|t| t.replace_all) {
-                l += beta * c;
+                *own += beta * c;
+                if course {
+                    roulette::course(t, e, &mut l, sample);
+                }
                 break;
             }
             // One by one: picked as a pair, the two colours went through memory in pieces of other
@@ -212,12 +222,16 @@ impl<'a> PathTracer<'a> {
                         // A delta light's numbers are never read: plain ones, not a padded dimension
                         // (the independent sampler draws the same numbers either way).
                         let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
-                        self.direct(&at, beta, origin, i, u, 1.0, log, &mut l);
+                        self.direct(&at, beta, origin, i, u, 1.0, log, own);
                     }
                     if let Some((i, chosen)) = self.choose_light(pick) {
-                        self.direct(&at, beta, origin, i, u, chosen, log, &mut l);
+                        self.direct(&at, beta, origin, i, u, chosen, log, own);
                     }
                 }
+            }
+            if course {
+                let Some(q) = roulette::course(t, e, &mut l, sample) else { break };
+                beta /= q;
             }
 
             if bounce >= max_bounces {
@@ -239,6 +253,9 @@ impl<'a> PathTracer<'a> {
                     break;
                 };
                 beta *= lobe.weight * (total / luminance(lobe.weight));
+                if course {
+                    t *= lobe.weight;
+                }
                 if p_brdf > 0.0 {
                     beta /= 1.0 - p_brdf;
                 }
@@ -255,18 +272,19 @@ impl<'a> PathTracer<'a> {
                 if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
                     break;
                 }
-                beta *= at.f(wi) * (cos / pdf);
+                let f = at.f(wi);
+                beta *= f * (cos / pdf);
+                if course {
+                    t *= f;
+                }
                 if p_brdf < 1.0 {
                     beta /= p_brdf;
                 }
                 last = Some((s.p, p_brdf * pdf));
                 wi
             };
-            if o.russian_roulette {
-                let q = beta.max_element().min(1.0);
-                if sample.rng.next_f32() >= q {
-                    break;
-                }
+            if o.roulette == Roulette::Unbiased {
+                let Some(q) = roulette::unbiased(beta, sample) else { break };
                 beta /= q;
             }
             if beta == Color::ZERO {
@@ -383,68 +401,4 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 
 fn luminance(c: Color) -> f32 {
     crate::tonemap::luminance(c).max(0.0)
-}
-
-/// A direction over the hemisphere of unit `n`, uniform in solid angle, and its pdf `1/2π`.
-pub fn uniform_hemisphere(n: Vec3, u: Vec2) -> (Vec3, f32) {
-    let z = u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * std::f32::consts::PI * u.y;
-    (local_to_world(n, Vec3::new(r * phi.cos(), r * phi.sin(), z)), 1.0 / (2.0 * std::f32::consts::PI))
-}
-
-/// A direction over the hemisphere of unit `n` with density `cos θ / π` (Malley's method: a uniform
-/// point of the unit disc lifted to the hemisphere), and that density.
-pub fn cosine_hemisphere(n: Vec3, u: Vec2) -> (Vec3, f32) {
-    let r = u.x.sqrt();
-    let phi = 2.0 * std::f32::consts::PI * u.y;
-    let z = (1.0 - u.x).max(0.0).sqrt();
-    (local_to_world(n, Vec3::new(r * phi.cos(), r * phi.sin(), z)), z / std::f32::consts::PI)
-}
-
-fn local_to_world(n: Vec3, v: Vec3) -> Vec3 {
-    let (a, b) = orthonormal_basis(n);
-    (a * v.x + b * v.y + n * v.z).normalize_or(n)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// ∫ g over the sphere of directions, by the midpoint rule in (cos θ, φ).
-    fn integrate(g: impl Fn(Vec3) -> f32) -> f32 {
-        let (nz, nphi) = (400, 400);
-        let mut sum = 0.0;
-        for i in 0..nz {
-            for j in 0..nphi {
-                let z = -1.0 + 2.0 * (i as f32 + 0.5) / nz as f32;
-                let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / nphi as f32;
-                let r = (1.0 - z * z).sqrt();
-                sum += g(Vec3::new(r * phi.cos(), r * phi.sin(), z));
-            }
-        }
-        sum * 4.0 * std::f32::consts::PI / (nz * nphi) as f32
-    }
-
-    #[test]
-    fn path_hemisphere_samplers_stay_above_and_their_pdfs_integrate_to_one() {
-        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
-        let cos_pdf = |w: Vec3| w.dot(n).max(0.0) / std::f32::consts::PI;
-        let uni_pdf = |w: Vec3| if w.dot(n) > 0.0 { 1.0 / (2.0 * std::f32::consts::PI) } else { 0.0 };
-        assert!((integrate(cos_pdf) - 1.0).abs() < 2e-3 && (integrate(uni_pdf) - 1.0).abs() < 2e-3);
-        let mut rng = crate::sampler::Rng::for_sample(1, 2, 3, 4);
-        let (mut mean_cos_c, mut mean_cos_u) = (0.0, 0.0);
-        let k = 20_000;
-        for _ in 0..k {
-            let (c, pc) = cosine_hemisphere(n, rng.next_2d());
-            let (u, pu) = uniform_hemisphere(n, rng.next_2d());
-            assert!(c.dot(n) >= 0.0 && u.dot(n) >= 0.0);
-            assert!((pc - cos_pdf(c)).abs() < 1e-4 && (pu - uni_pdf(u)).abs() < 1e-6);
-            mean_cos_c += c.dot(n) / k as f32;
-            mean_cos_u += u.dot(n) / k as f32;
-        }
-        // E[cos θ] is 2/3 under the cosine density, 1/2 under the uniform one.
-        assert!((mean_cos_c - 2.0 / 3.0).abs() < 0.01, "{mean_cos_c}");
-        assert!((mean_cos_u - 0.5).abs() < 0.01, "{mean_cos_u}");
-    }
 }

@@ -465,7 +465,7 @@ mod tests {
 
     #[test]
     fn metu_renderer_and_its_params_are_read_per_camera() {
-        use crate::renderer::{PathOptions, Renderer};
+        use crate::renderer::{PathOptions, Renderer, Roulette};
         let read = |depth: u32, extra: &str| {
             read_xml(&format!("<MaxRecursionDepth>{depth}</MaxRecursionDepth>{}", camera(extra)))
         };
@@ -474,7 +474,7 @@ mod tests {
         assert!(d.warnings.is_empty(), "{:?}", d.warnings);
         let all = "<Renderer>PathTracing</Renderer><RendererParams> NextEventEstimation ImportanceSampling \
                    RussianRoulette</RendererParams>";
-        let want = PathOptions { next_event: true, importance_sampling: true, russian_roulette: true, mis: false };
+        let want = PathOptions { next_event: true, importance_sampling: true, roulette: Roulette::Course, mis: false };
         assert_eq!(read(3, all).unwrap().cameras[0].renderer, Renderer::PathTracing(want));
         // MIS brings the two samplings it weighs.
         let mis = read(3, "<Renderer>PathTracing</Renderer><RendererParams>MIS</RendererParams>").unwrap();

@@ -5,7 +5,7 @@
 //! wide that its width or height overflows `f32`.
 
 use super::Reader;
-use crate::renderer::{PathOptions, Renderer};
+use crate::renderer::{PathOptions, Renderer, Roulette};
 use crate::scene::desc::{CameraDesc, Lens, Window};
 use crate::scene::readers::tree::Node;
 use crate::tonemap::{Operator, Tonemap};
@@ -193,7 +193,11 @@ impl Reader<'_> {
                     let flag = match word {
                         "NextEventEstimation" => &mut o.next_event,
                         "ImportanceSampling" => &mut o.importance_sampling,
-                        "RussianRoulette" => &mut o.russian_roulette,
+                        // The element means what the course's renderer does with it.
+                        "RussianRoulette" => {
+                            o.roulette = Roulette::Course;
+                            continue;
+                        }
                         "MIS" => &mut o.mis,
                         other => {
                             let msg = format!(
@@ -206,7 +210,7 @@ impl Reader<'_> {
                     *flag = true;
                 }
                 let o = o.implied();
-                if self.desc.max_depth == 0 && !o.russian_roulette {
+                if self.desc.max_depth == 0 && o.roulette == Roulette::Off {
                     let msg = format!(
                         "Camera {id}: path tracing with MaxRecursionDepth 0 follows no bounce: emitters and, with \
                          NextEventEstimation, direct light only"
