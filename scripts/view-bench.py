@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Speed of `arbor view` (project issue 32), measured from outside, as the page sees it.
 
-    scripts/view-bench.py --arbor target/release/arbor [--threads 2] [--rounds 5] [SCENE ...]
+    scripts/view-bench.py --arbor target/release/arbor [--threads 2] [--rounds 5] [--size 480x360] [SCENE ...]
 
 For each scene (default: the built-in Cornell box, and `../shared/meshes/igea.ply` in a lit scene that
 this script writes to a temporary folder), it starts `arbor view`, then over HTTP:
-- first frame: the time from a view request to its first image (the quarter-resolution preview) and to
-  its first full-resolution image (one sample), 480x360, Whitted, median of --rounds;
+- first frame: the time from a view request to its first image (the quarter-resolution preview, or the
+  full frame when full passes are fast enough to skip it) and to
+  its first full-resolution image (one sample), 480x360 (--size), Whitted, median of --rounds;
 - orbiting: views turned by 2 degrees one after the other, each as soon as the last one's first
   full-resolution image has come, for 3 seconds: full-resolution frames per second;
 - cancel: a 64-sample view at 960x720 is requested, then after 0.3 s a new view: the time from the new
@@ -86,7 +87,7 @@ def turned(cam, target, degrees):
     return new_eye, [t - e for t, e in zip(target, new_eye)], up
 
 
-def measure(arbor, scene, threads, rounds):
+def measure(arbor, scene, threads, rounds, size):
     proc, base, token = start(arbor, scene, threads)
     try:
         c = Client(base, token)
@@ -94,7 +95,7 @@ def measure(arbor, scene, threads, rounds):
         cam = info["cameras"][0]
         b = info["bounds"]
         target = [(lo + hi) / 2 for lo, hi in zip(b["min"], b["max"])]
-        w, h = 480, round(480 * cam["height"] / cam["width"])
+        w, h = size
         base_view = {"camera": 0, "width": w, "height": h, "integrator": "whitted", "spp": 1}
         seq = 0
         first, full = [], []
@@ -104,7 +105,8 @@ def measure(arbor, scene, threads, rounds):
             v = c.view({**base_view, "eye": eye, "gaze": gaze, "up": up})
             seq, hv, _ = c.image(seq, v)
             first.append((time.perf_counter() - t0) * 1e3)
-            seq, hv, _ = c.image(seq, v, want_samples=1)
+            if int(hv["x-samples"]) < 1:  # a preview came first (no preview while full passes are fast)
+                seq, hv, _ = c.image(seq, v, want_samples=1)
             full.append((time.perf_counter() - t0) * 1e3)
         # Orbiting.
         frames, convert, download, angle = 0, [], [], 0.0
@@ -135,7 +137,7 @@ def measure(arbor, scene, threads, rounds):
             cancels.append((time.perf_counter() - t0) * 1e3)
         return {
             "scene": str(scene or "(built-in example)"), "size": f"{w}x{h}", "threads": threads,
-            "first_preview_ms": statistics.median(first), "first_full_ms": statistics.median(full),
+            "first_image_ms": statistics.median(first), "first_full_ms": statistics.median(full),
             "orbit_fps": fps, "orbit_frames": frames,
             "new_view_while_heavy_ms": statistics.median(cancels),
             "convert_ms": statistics.median(convert), "download_ms": statistics.median(download),
@@ -171,6 +173,7 @@ def main():
     p.add_argument("--arbor", default=str(ROOT / "target/release/arbor"))
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--rounds", type=int, default=5)
+    p.add_argument("--size", default="480x360", help="view size WxH (the camera's near plane is stretched to it)")
     p.add_argument("--meshes", default=os.environ.get("ARBOR_MESHES", str(ROOT.parent / "shared/meshes")))
     p.add_argument("scenes", nargs="*")
     args = p.parse_args()
@@ -179,7 +182,8 @@ def main():
         igea = igea_scene(tmp, args.meshes)
         scenes = [Path(s) for s in args.scenes] if args.scenes else [None] + ([igea] if igea else [])
         for scene in scenes:
-            r = measure(args.arbor, scene, args.threads, args.rounds)
+            size = tuple(int(v) for v in args.size.split("x"))
+            r = measure(args.arbor, scene, args.threads, args.rounds, size)
             print(json.dumps(r), flush=True)
 
 

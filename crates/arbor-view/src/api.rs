@@ -6,7 +6,6 @@
 //! side-by-side heatmaps) take one of [`HEAVY`] slots or get 503; event streams one of [`STREAMS`].
 
 use std::collections::HashMap;
-use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -14,6 +13,7 @@ use arbor::accel::{AccelConfig, AccelKind};
 use arbor::integrator::DebugView;
 use arbor::render::{render_camera, RenderOptions};
 use axum::body::{Body, Bytes};
+use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Query, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -29,7 +29,6 @@ use crate::bench::Bench;
 use crate::frames::{Frames, Image};
 use crate::json::{camera_json, view_request, MAX_SIDE, MAX_SPP};
 use crate::structures::{label, stats_json, Structures};
-use crate::ViewConfig;
 
 /// The largest request body, in bytes.
 pub const MAX_BODY: usize = 16 * 1024;
@@ -52,19 +51,20 @@ const PAGE: &str = concat!(
     "</script>\n</body>\n</html>\n"
 );
 
-struct App {
-    structures: Arc<Structures>,
-    frames: Arc<Frames>,
-    bench: Arc<Bench>,
-    events: broadcast::Sender<String>,
-    token: String,
-    hosts: Vec<String>,
-    heavy: Arc<Semaphore>,
-    streams: Arc<Semaphore>,
-    compared: Mutex<HashMap<String, Arc<Image>>>,
+/// What every route shares.
+pub(crate) struct App {
+    pub(crate) structures: Arc<Structures>,
+    pub(crate) frames: Arc<Frames>,
+    pub(crate) bench: Arc<Bench>,
+    pub(crate) events: broadcast::Sender<String>,
+    pub(crate) token: String,
+    pub(crate) hosts: Vec<String>,
+    pub(crate) heavy: Arc<Semaphore>,
+    pub(crate) streams: Arc<Semaphore>,
+    pub(crate) compared: Mutex<HashMap<String, Arc<Image>>>,
 }
 
-type Shared = Arc<App>;
+pub(crate) type Shared = Arc<App>;
 
 /// An error answer: a status and a message.
 pub struct ApiError(StatusCode, String);
@@ -85,97 +85,8 @@ fn ok_json(v: Value) -> Response {
     ([(header::CONTENT_TYPE, "application/json"), (header::CACHE_CONTROL, "no-store")], v.to_string()).into_response()
 }
 
-/// A running `arbor view` server.
-pub struct Server {
-    addr: SocketAddr,
-    token: String,
-    runtime: Option<tokio::runtime::Runtime>,
-    stop: Option<tokio::sync::oneshot::Sender<()>>,
-}
-
-impl Server {
-    /// Builds the scene, binds `config.addr` and starts serving in the background.
-    pub fn start(config: ViewConfig) -> Result<Server, arbor::Error> {
-        let token = match config.token {
-            Some(t) => t,
-            None => crate::random_token().map_err(|e| arbor::Error::Invalid(format!("cannot draw a token: {e}")))?,
-        };
-        let (events, _) = broadcast::channel(256);
-        let structures = Arc::new(Structures::new(config.desc, config.accel, events.clone())?);
-        let frames = Frames::start(structures.clone(), events.clone());
-        let runtime = tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(2)
-            .max_blocking_threads(HEAVY + 2)
-            .enable_all()
-            .build()
-            .map_err(|e| arbor::Error::Invalid(format!("cannot start the server: {e}")))?;
-        let listener = runtime
-            .block_on(tokio::net::TcpListener::bind(config.addr))
-            .map_err(|e| arbor::Error::Invalid(format!("cannot listen on {}: {e}", config.addr)))?;
-        let addr = listener.local_addr().map_err(|e| arbor::Error::Invalid(e.to_string()))?;
-        let hosts = allowed_hosts(addr);
-        let app = Arc::new(App {
-            structures,
-            frames,
-            bench: Arc::new(Bench::default()),
-            events,
-            token: token.clone(),
-            hosts,
-            heavy: Arc::new(Semaphore::new(HEAVY)),
-            streams: Arc::new(Semaphore::new(STREAMS)),
-            compared: Mutex::new(HashMap::new()),
-        });
-        let router = routes(app);
-        let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
-        runtime.spawn(async move {
-            let serve = axum::serve(crate::listener::Limited::new(listener), router);
-            let _ = serve
-                .with_graceful_shutdown(async move {
-                    let _ = stopped.await;
-                })
-                .await;
-        });
-        Ok(Server { addr, token, runtime: Some(runtime), stop: Some(stop) })
-    }
-
-    /// The address it listens on.
-    pub fn addr(&self) -> SocketAddr {
-        self.addr
-    }
-
-    /// The token every request needs.
-    pub fn token(&self) -> &str {
-        &self.token
-    }
-
-    /// The URL to open: the page, with its token.
-    pub fn url(&self) -> String {
-        format!("http://{}/?token={}", self.addr, self.token)
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        if let Some(stop) = self.stop.take() {
-            let _ = stop.send(());
-        }
-        if let Some(rt) = self.runtime.take() {
-            rt.shutdown_timeout(Duration::from_secs(1));
-        }
-    }
-}
-
-/// The `Host` values a request may carry: the address served, and for loopback `localhost` too.
-fn allowed_hosts(addr: SocketAddr) -> Vec<String> {
-    let port = addr.port();
-    let mut hosts = vec![addr.to_string()];
-    if addr.ip().is_loopback() {
-        hosts.extend([format!("localhost:{port}"), format!("127.0.0.1:{port}"), format!("[::1]:{port}")]);
-    }
-    hosts
-}
-
-fn routes(app: Shared) -> Router {
+/// Every route, behind the host and token checks.
+pub(crate) fn routes(app: Shared) -> Router {
     Router::new()
         .route("/", get(page))
         .route("/api/scene", get(scene))
@@ -188,6 +99,10 @@ fn routes(app: Shared) -> Router {
         .route("/api/compare/image", get(compare_image))
         .route("/api/bench", get(bench_state).post(bench_start))
         .fallback(|| async { ApiError(StatusCode::NOT_FOUND, "no such page or endpoint".into()) })
+        // The router adds the `Allow` header.
+        .method_not_allowed_fallback(|method: axum::http::Method, uri: axum::http::Uri| async move {
+            ApiError(StatusCode::METHOD_NOT_ALLOWED, format!("{method} is not allowed on {}", uri.path()))
+        })
         .layer(middleware::from_fn_with_state(app.clone(), guard))
         .layer(DefaultBodyLimit::max(MAX_BODY))
         .with_state(app)
@@ -257,13 +172,19 @@ async fn scene(State(app): State<Shared>) -> Response {
     }))
 }
 
-/// Reads a JSON body.
-fn body_json(body: &Bytes) -> Result<Value, ApiError> {
-    serde_json::from_slice(body).map_err(|e| bad(format!("the body is not JSON: {e}")))
+/// Reads a JSON body: at most [`MAX_BODY`] bytes (413 beyond), well framed (400 if not), JSON.
+fn body_json(body: Result<Bytes, BytesRejection>) -> Result<Value, ApiError> {
+    let body = body.map_err(|e| match e.status() {
+        StatusCode::PAYLOAD_TOO_LARGE => {
+            ApiError(StatusCode::PAYLOAD_TOO_LARGE, format!("the body is larger than {MAX_BODY} bytes"))
+        }
+        status => ApiError(status, format!("the body could not be read: {}", e.body_text())),
+    })?;
+    serde_json::from_slice(&body).map_err(|e| bad(format!("the body is not JSON: {e}")))
 }
 
-async fn set_view(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
-    let request = view_request(&body_json(&body)?, &app.structures.scene()).map_err(bad)?;
+async fn set_view(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
+    let request = view_request(&body_json(body)?, &app.structures.scene()).map_err(bad)?;
     let view = app.frames.set_view(request);
     Ok(ok_json(json!({ "view": view })))
 }
@@ -352,14 +273,20 @@ async fn events(State(app): State<Shared>) -> Result<Response, ApiError> {
     Ok(Sse::new(hello.chain(stream)).keep_alive(KeepAlive::default()).into_response())
 }
 
-/// Runs `work` on a blocking thread if a heavy slot is free.
+/// Runs `work` on a blocking thread if a heavy slot is free. The work holds the slot until it ends: a
+/// client that goes away drops the request, not the work, which must not make room for more.
 async fn heavy<T: Send + 'static>(app: &Shared, work: impl FnOnce() -> T + Send + 'static) -> Result<T, ApiError> {
-    let _permit = app
+    let permit = app
         .heavy
         .clone()
         .try_acquire_owned()
         .map_err(|_| ApiError(StatusCode::SERVICE_UNAVAILABLE, "busy: try again".into()))?;
-    tokio::task::spawn_blocking(work).await.map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
+    tokio::task::spawn_blocking(move || {
+        let _held = permit;
+        work()
+    })
+    .await
+    .map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
 }
 
 async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, String>>) -> Result<Response, ApiError> {
@@ -379,8 +306,8 @@ async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, Stri
     Ok(ok_json(v))
 }
 
-async fn rebuild(State(app): State<Shared>, body: Bytes) -> Result<Response, ApiError> {
-    let body = body_json(&body)?;
+async fn rebuild(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
+    let body = body_json(body)?;
     let kind =
         body.get("kind").and_then(Value::as_str).ok_or_else(|| bad("\"kind\" (a structure name) is required"))?;
     let kind: AccelKind = kind.parse().map_err(|e| bad(format!("\"kind\": {e}")))?;

@@ -11,7 +11,9 @@
 //!   (which cancels the pass in flight) or its sample budget is spent.
 //! - [`structures`]: the scene under the current structure, rebuilt in the background on request, and
 //!   the other structures built for the comparisons (side-by-side heatmaps, the benchmark chart).
-//! - [`api`]: the routes, and the checks every request passes (token, host, sizes).
+//! - [`api`]: the routes, and the checks every request passes (token, host, sizes); `server`: the
+//!   [`Server`] that builds all this and serves the routes, with a bound on connections and a deadline
+//!   for each request's headers (`listener`).
 //!
 //! The server is axum on a small tokio runtime: well kept, with Server-Sent Events for the page's
 //! notifications, request-size and concurrency limits from tower, and no C dependencies. Long work (a
@@ -27,6 +29,7 @@ pub mod frames;
 mod inspect;
 mod json;
 mod listener;
+mod server;
 pub mod structures;
 
 use std::net::SocketAddr;
@@ -34,7 +37,7 @@ use std::net::SocketAddr;
 use arbor::accel::AccelConfig;
 use arbor::scene::SceneDesc;
 
-pub use api::Server;
+pub use server::Server;
 
 /// What `arbor view` serves.
 pub struct ViewConfig {

@@ -1,6 +1,11 @@
-//! A TCP listener that holds at most [`MAX_CONNECTIONS`] connections open: the next one is accepted only
-//! once one closes (the operating system's backlog holds the rest), so no number of clients can make
-//! the server hold unbounded sockets, buffers or tasks.
+//! The server's connections: a TCP listener that holds at most [`MAX_CONNECTIONS`] connections open
+//! (the next one is accepted only once one closes; the operating system's backlog holds the rest), and
+//! the loop that serves each over HTTP/1.1 with a deadline for its request headers ([`HEADER_TIMEOUT`]),
+//! so that no number of clients, and no client that sends a request slowly or not at all, can make the
+//! server hold unbounded sockets, buffers or tasks, or keep a slot forever.
+//!
+//! `axum::serve` sets no timer on hyper, so hyper's header deadline never applies there; this loop is
+//! hyper's own connection builder with a timer, which axum's is too.
 
 use std::io;
 use std::pin::Pin;
@@ -13,6 +18,29 @@ use tokio::sync::{OwnedSemaphorePermit, Semaphore};
 
 /// Connections open at once.
 pub const MAX_CONNECTIONS: usize = 32;
+/// Time a connection has to send a request's headers, the first or the next one on a kept-alive
+/// connection; past it the connection is closed and its slot given back.
+pub const HEADER_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Serves `router` on `listener` until `stop` resolves. Each connection runs on a task of its own;
+/// a connection's error (a reset, a header deadline passed) closes that connection only.
+pub async fn serve(listener: TcpListener, router: axum::Router, stop: impl std::future::Future<Output = ()>) {
+    let mut limited = Limited::new(listener);
+    let mut http = hyper::server::conn::http1::Builder::new();
+    http.timer(hyper_util::rt::TokioTimer::new()).header_read_timeout(HEADER_TIMEOUT);
+    tokio::pin!(stop);
+    loop {
+        let connection = tokio::select! {
+            _ = &mut stop => return,
+            (connection, _) = axum::serve::Listener::accept(&mut limited) => connection,
+        };
+        let service = hyper_util::service::TowerToHyperService::new(router.clone());
+        let serving = http.serve_connection(hyper_util::rt::TokioIo::new(connection), service);
+        tokio::spawn(async move {
+            let _ = serving.await;
+        });
+    }
+}
 
 /// [`TcpListener`] with a bound on open connections.
 pub struct Limited {

@@ -83,6 +83,7 @@ function overlayValue() {
 async function requestView() {
   if (state.sending) { state.dirty = true; return; }
   state.sending = true;
+  delete $("view").dataset.asked;
   try {
     const body = {
       camera: state.camera, eye: state.eye, gaze: state.gaze, up: state.up,
@@ -95,7 +96,10 @@ async function requestView() {
     status(`view refused: ${e.message}`);
   }
   state.sending = false;
-  if (state.dirty) { state.dirty = false; requestView(); }
+  if (state.dirty) { state.dirty = false; requestView(); return; }
+  // The view the server is on, once no other is on its way; absent while one is (for the browser
+  // test, with data-view: the page shows what it last asked for when both are equal).
+  $("view").dataset.asked = String(state.view);
 }
 
 function status(text) { $("status").textContent = text; }
@@ -137,6 +141,7 @@ async function follow(channel) {
           `${f.mrays.toFixed(2)} Mrays/s · server ${f.convert.toFixed(1)} ms · view ${state.view}`);
         $("view").dataset.samples = String(f.samples);
         $("view").dataset.seq = String(f.seq);
+        $("view").dataset.view = h("x-view");
       } else {
         const max = h("x-heatmap-max");
         $("heatmap-legend").hidden = max === null;
@@ -371,7 +376,9 @@ function listen() {
   events.onmessage = async (m) => {
     const e = JSON.parse(m.data);
     if (e.type === "build") {
-      if (e.state === "running") $("build-status").textContent = `building ${e.kind} (${e.purpose}): ${(e.elapsed_ms / 1000).toFixed(1)} s`;
+      // The structures built for a comparison or the benchmark have their own status lines there:
+      // this one is the current structure's, and keeps its last word until the next rebuild.
+      if (e.state === "running" && e.purpose === "current") $("build-status").textContent = `building ${e.kind}: ${(e.elapsed_ms / 1000).toFixed(1)} s`;
       if (e.state === "failed") $("build-status").textContent = `build of ${e.kind} failed: ${e.error}`;
       if (e.state === "done") { showStats(e.stats, false); $("build-status").textContent = `built ${e.kind} in ${e.stats.build_ms.toFixed(1)} ms`; }
     } else if (e.type === "bench") {

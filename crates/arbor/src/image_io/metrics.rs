@@ -3,7 +3,7 @@
 //! channel, image minus reference).
 //!
 //! All statistics are over the three channels of every pixel (alpha is never compared: [`compare_files`]
-//! reads both images as 8-bit RGB with [`read`](super::read), within the pixel budget it is given). PSNR uses a peak of 255:
+//! reads both images as 8-bit RGB with [`read`](fn@super::read), within the pixel budget it is given). PSNR uses a peak of 255:
 //! `10 log10(255^2 / MSE)`, infinite for identical images. A pixel is "off" when any of its channels
 //! differs by strictly more than the threshold, so threshold 0 counts every difference. Cost: one pass.
 //!

@@ -8,7 +8,7 @@
 //!   ([`Tonemap`](crate::tonemap::Tonemap)): a high-dynamic-range image plus a tone-mapped PNG beside it.
 //! - [`read_image`]: PNG, JPEG, PNM, OpenEXR, Radiance HDR into a film in display units (integer samples
 //!   divided by their maximum, float samples as they are); [`read_rgb8`] for exact 8-bit comparisons;
-//!   [`read`] and [`decode`] into any [`Texel`]. Every read is held to a pixel budget
+//!   [`read`](fn@read) and [`decode`] into any [`Texel`]. Every read is held to a pixel budget
 //!   ([`ImageLimits`]) checked from the file's header before decoding, and allocates fallibly.
 //! - [`metrics`]: PSNR, RMSE, bias and the share of differing pixels (or KxK-pixel block means, for noisy
 //!   renders) against a reference image; [`levels`]: images as display levels for comparing them (an HDR
