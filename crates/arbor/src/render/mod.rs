@@ -142,12 +142,7 @@ pub fn render_camera(
     let mut film = Film::try_new(w, h)?;
     let (traced, stats, scale) = trace(scene, cam, opts, progress)?;
     let count = stats.samples.1 - stats.samples.0;
-    for ((x0, y0, tw), sums, _, _) in traced {
-        for (k, s) in sums.into_iter().enumerate() {
-            let (x, y) = (x0 as usize + k % tw as usize, y0 as usize + k / tw as usize);
-            film.pixels[y * w as usize + x] = s.value(scale, count);
-        }
-    }
+    scatter(traced, (0, 0), w as usize, |i, s| film.pixels[i] = s.value(scale, count));
     let heatmap_max = match opts.debug {
         Some(DebugView::Heatmap) => Some(heatmap_finish(&mut film, opts.heatmap_scale)),
         Some(DebugView::Boxes { depth }) => {
@@ -195,14 +190,20 @@ pub fn render_sums(
     let mut sums = sums_buffer(window)?;
     sums.resize(ww * (window.3 - window.1) as usize, SampleSum::default());
     let (traced, stats, scale) = trace(scene, cam, &opts, progress)?;
-    for ((x0, y0, tw), tile, _, _) in traced {
-        for (k, s) in tile.into_iter().enumerate() {
-            let (x, y) = ((x0 - window.0) as usize + k % tw as usize, (y0 - window.1) as usize + k / tw as usize);
-            sums[y * ww + x] = s;
-        }
-    }
+    scatter(traced, (window.0, window.1), ww, |i, s| sums[i] = s);
     let frame = (cam.width, cam.height);
     Ok((RenderSums { frame, window, spp: stats.spp, samples: stats.samples, scale, sums }, stats))
+}
+
+/// Hands each traced tile's sums to `put` with their row-major index in a buffer `width` pixels wide
+/// whose first pixel is frame pixel `origin`.
+fn scatter(traced: Traced, origin: (u32, u32), width: usize, mut put: impl FnMut(usize, SampleSum)) {
+    for ((x0, y0, tw), tile, _, _) in traced {
+        let (x0, y0, tw) = ((x0 - origin.0) as usize, (y0 - origin.1) as usize, tw as usize);
+        for (k, s) in tile.into_iter().enumerate() {
+            put((y0 + k / tw) * width + x0 + k % tw, s);
+        }
+    }
 }
 
 /// An empty buffer with room for the sums of `window`'s pixels, or [`crate::Error::OutOfMemory`].
