@@ -2,7 +2,9 @@
 //! passes first: the `Host` header names this server (a web page on another name cannot reach it through
 //! DNS rebinding), and the token is there, as `?token=` or an `X-Arbor-Token` header (a local user or a
 //! page that does not know it can do nothing). Bodies are JSON of at most [`MAX_BODY`] bytes; a bad
-//! request is a 4xx with `{"error": "..."}`, never a panic. Heavy requests (inspecting a pixel, the
+//! request is a 4xx with `{"error": "..."}`, never a panic; a body that does not arrive whole within
+//! [`crate::listener::HEADER_TIMEOUT`] of its headers is a 408, so a client that sends a body slowly or not
+//! at all cannot hold a connection slot.  Heavy requests (inspecting a pixel, the
 //! side-by-side heatmaps) take one of [`HEAVY`] slots or get 503; event streams one of [`STREAMS`].
 
 use std::collections::HashMap;
@@ -14,7 +16,7 @@ use arbor::integrator::DebugView;
 use arbor::render::{render_camera, RenderOptions};
 use axum::body::{Body, Bytes};
 use axum::extract::rejection::BytesRejection;
-use axum::extract::{DefaultBodyLimit, Query, Request, State};
+use axum::extract::{DefaultBodyLimit, FromRequest, Query, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
 use axum::response::sse::{Event, KeepAlive, Sse};
@@ -172,9 +174,14 @@ async fn scene(State(app): State<Shared>) -> Response {
     }))
 }
 
-/// Reads a JSON body: at most [`MAX_BODY`] bytes (413 beyond), well framed (400 if not), JSON.
-fn body_json(body: Result<Bytes, BytesRejection>) -> Result<Value, ApiError> {
-    let body = body.map_err(|e| match e.status() {
+/// Reads a JSON body: at most [`MAX_BODY`] bytes (413 beyond), well framed (400 if not), whole within
+/// the headers' deadline (408 if not), JSON.
+async fn body_json(request: Request) -> Result<Value, ApiError> {
+    let deadline = crate::listener::HEADER_TIMEOUT;
+    let body = tokio::time::timeout(deadline, Bytes::from_request(request, &())).await.map_err(|_| {
+        ApiError(StatusCode::REQUEST_TIMEOUT, format!("the body did not arrive within {} s", deadline.as_secs()))
+    })?;
+    let body = body.map_err(|e: BytesRejection| match e.status() {
         StatusCode::PAYLOAD_TOO_LARGE => {
             ApiError(StatusCode::PAYLOAD_TOO_LARGE, format!("the body is larger than {MAX_BODY} bytes"))
         }
@@ -183,8 +190,8 @@ fn body_json(body: Result<Bytes, BytesRejection>) -> Result<Value, ApiError> {
     serde_json::from_slice(&body).map_err(|e| bad(format!("the body is not JSON: {e}")))
 }
 
-async fn set_view(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
-    let request = view_request(&body_json(body)?, &app.structures.scene()).map_err(bad)?;
+async fn set_view(State(app): State<Shared>, request: Request) -> Result<Response, ApiError> {
+    let request = view_request(&body_json(request).await?, &app.structures.scene()).map_err(bad)?;
     let view = app.frames.set_view(request);
     Ok(ok_json(json!({ "view": view })))
 }
@@ -306,8 +313,8 @@ async fn inspect(State(app): State<Shared>, Query(q): Query<HashMap<String, Stri
     Ok(ok_json(v))
 }
 
-async fn rebuild(State(app): State<Shared>, body: Result<Bytes, BytesRejection>) -> Result<Response, ApiError> {
-    let body = body_json(body)?;
+async fn rebuild(State(app): State<Shared>, request: Request) -> Result<Response, ApiError> {
+    let body = body_json(request).await?;
     let kind =
         body.get("kind").and_then(Value::as_str).ok_or_else(|| bad("\"kind\" (a structure name) is required"))?;
     let kind: AccelKind = kind.parse().map_err(|e| bad(format!("\"kind\": {e}")))?;

@@ -1,6 +1,7 @@
 //! Connections that never finish a request: the server holds at most 32 connections, so clients that
 //! open them and send half a request (slowloris) would lock everyone out if the server waited for them
-//! forever. Each connection has 10 s to send its headers (`listener::HEADER_TIMEOUT`).
+//! forever. Each connection has 10 s to send its headers (`listener::HEADER_TIMEOUT`), and a body as long
+//! again after them.
 
 mod common;
 
@@ -34,4 +35,29 @@ fn clients_that_never_finish_their_headers_do_not_lock_the_server_out() {
             Err(e) => assert_ne!(e.kind(), std::io::ErrorKind::WouldBlock, "a stalled connection is still open"),
         }
     }
+}
+
+#[test]
+fn clients_that_never_finish_their_bodies_get_408_and_do_not_lock_the_server_out() {
+    let server = start();
+    let (addr, token) = (server.addr(), server.token());
+    let half = format!(
+        "POST /api/view HTTP/1.1\r\nHost: {addr}\r\nX-Arbor-Token: {token}\r\nContent-Length: 100\r\n\r\n{{\"camera\""
+    );
+    let mut stalled: Vec<TcpStream> = (0..32)
+        .map(|_| {
+            let mut s = TcpStream::connect(addr).expect("connects");
+            s.write_all(half.as_bytes()).unwrap();
+            s.set_read_timeout(Some(HANG_GUARD)).unwrap();
+            s
+        })
+        .collect();
+    // Without the body's deadline every slot stays taken and this waits for the hang guard.
+    let reply = get(&server, "/api/scene");
+    assert_eq!(reply.status, 200, "{}", reply.error());
+    let mut answer = Vec::new();
+    let _ = stalled[0].read_to_end(&mut answer);
+    let answer = String::from_utf8_lossy(&answer);
+    assert!(answer.starts_with("HTTP/1.1 408"), "a stalled body is answered 408: {answer}");
+    assert!(answer.contains("the body did not arrive within 10 s"), "{answer}");
 }

@@ -39,7 +39,7 @@ fn an_unmoved_views_first_full_frame_is_arbor_render_spp_1() {
     let server = start();
     let mut events = Events::open(&server);
     let view = set_view(&server, r#"{"camera": 0, "spp": 2}"#);
-    let seen = events.until(|e| e["type"] == "frame" && e["view"] == view && e["samples"] == 2);
+    let seen = events.until_frame(view, 2);
     // The low-resolution preview comes first, then full-resolution passes, one sample more each.
     let frames: Vec<(u64, u64)> =
         frames_of(&seen, view).iter().map(|e| (e["samples"].as_u64().unwrap(), e["width"].as_u64().unwrap())).collect();
@@ -70,13 +70,13 @@ fn a_new_view_cancels_the_one_in_flight() {
     let mut events = Events::open(&server);
     // A view that would take hours: path tracing, every sample the limits allow.
     let slow = set_view(&server, r#"{"camera": 0, "integrator": "path", "spp": 65536}"#);
-    events.until(|e| e["type"] == "frame" && e["view"] == slow && e["samples"] == 1);
+    events.until_frame(slow, 1);
     let next = set_view(&server, r#"{"camera": 0, "width": 40, "height": 40, "spp": 1}"#);
     // Without the cancel, the slow view's passes would go on and this would wait for ever (the hang
     // guard fails it).
-    let mut seen = events.until(|e| e["type"] == "frame" && e["view"] == next && e["samples"] == 1);
+    let mut seen = events.until_frame(next, 1);
     let last = set_view(&server, r#"{"camera": 0, "width": 20, "height": 20, "spp": 1}"#);
-    seen.extend(events.until(|e| e["type"] == "frame" && e["view"] == last && e["samples"] == 1));
+    seen.extend(events.until_frame(last, 1));
     let views: Vec<u64> = seen.iter().filter(|e| e["type"] == "frame").map(|e| e["view"].as_u64().unwrap()).collect();
     let first_next = views.iter().position(|&v| v == next).unwrap();
     assert!(
@@ -120,7 +120,7 @@ fn a_rebuild_runs_in_the_background_reports_and_refuses_a_second() {
     let server = start();
     let mut events = Events::open(&server);
     let view = set_view(&server, r#"{"camera": 0, "width": 32, "height": 32, "spp": 1}"#);
-    events.until(|e| e["type"] == "frame" && e["view"] == view && e["samples"] == 1);
+    events.until_frame(view, 1);
     let body = r#"{"kind": "kdtree", "params": {"depth": 12, "empty-bonus": "0.5"}}"#;
     let label = "kdtree traversal-cost=30 intersection-cost=20 empty-bonus=0.5 depth=12";
     {

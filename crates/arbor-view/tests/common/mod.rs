@@ -275,6 +275,11 @@ impl Events {
             }
         }
     }
+
+    /// [`Events::until`] view `view`'s frame of `samples` samples.
+    pub fn until_frame(&mut self, view: u64, samples: u64) -> Vec<Value> {
+        self.until(|e| e["type"] == "frame" && e["view"] == view && e["samples"] == samples)
+    }
 }
 
 /// Every thread of rayon's global pool held until this is dropped: the renderer's parallel work (a
