@@ -419,7 +419,7 @@ async fn bench_start(State(app): State<Shared>) -> Result<Response, ApiError> {
         .ok_or_else(|| ApiError(StatusCode::CONFLICT, "no view yet: POST /api/view first".into()))?;
     let scene = app.structures.scene();
     let cam = scene.cameras[view.camera].posed(view.eye, view.gaze, view.up, view.width, view.height);
-    if !app.bench.start(app.structures.clone(), cam, app.events.clone()) {
+    if !app.bench.start(app.structures.clone(), app.frames.clone(), cam, app.events.clone()) {
         return Err(ApiError(StatusCode::CONFLICT, "the benchmark is running".into()));
     }
     Ok((StatusCode::ACCEPTED, [(header::CONTENT_TYPE, "application/json")], r#"{"state":"running"}"#).into_response())

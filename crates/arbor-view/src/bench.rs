@@ -4,7 +4,10 @@
 //! cosine-weighted diffuse bounce from each hit, in parallel, timed. Brute force traces a deterministic
 //! sample of them ([`arbor::bench::sample`]) so that a large mesh does not take hours.
 //!
-//! Runs on a thread of its own, one at a time, reporting each structure as it is done.
+//! Each structure is built afresh for its row, so that its build time, like its ray rates, is measured
+//! while the view's passes are held ([`Frames::quiet`]): a build made earlier beside a render would
+//! report the render's load too. Runs on a thread of its own, one at a time, reporting each structure
+//! as it is done; the view resumes when it ends.
 
 use std::sync::{Arc, Mutex};
 
@@ -13,6 +16,7 @@ use arbor::bench::{diffuse_rays, primary_rays, sample, trace};
 use arbor::camera::Camera;
 use serde_json::{json, Value};
 
+use crate::frames::Frames;
 use crate::structures::{stats_json, Structures};
 
 /// Triangle tests brute force may spend per ray set.
@@ -35,6 +39,7 @@ impl Bench {
     pub fn start(
         self: &Arc<Self>,
         structures: Arc<Structures>,
+        frames: Arc<Frames>,
         cam: Camera,
         events: crate::structures::Events,
     ) -> bool {
@@ -47,7 +52,7 @@ impl Bench {
         }
         let me = self.clone();
         std::thread::spawn(move || {
-            let result = me.run(&structures, &cam, &events);
+            let result = me.run(&structures, &frames, &cam, &events);
             let mut s = me.state.lock().unwrap_or_else(|e| e.into_inner());
             s.0 = match result {
                 Ok(()) => "done".into(),
@@ -58,14 +63,21 @@ impl Bench {
         true
     }
 
-    fn run(&self, structures: &Structures, cam: &Camera, events: &crate::structures::Events) -> arbor::Result<()> {
+    fn run(
+        &self,
+        structures: &Structures,
+        frames: &Frames,
+        cam: &Camera,
+        events: &crate::structures::Events,
+    ) -> arbor::Result<()> {
+        let _quiet = frames.quiet();
         let reference = structures.with_kind(AccelKind::BvhSah)?;
         let primary = primary_rays(cam);
         let (hits, _) = trace(&reference.geometry, &primary);
         let diffuse = diffuse_rays(&reference, &primary, &hits);
         let prims = reference.geometry.counts.triangles + reference.geometry.counts.spheres;
         for &kind in AccelKind::ALL {
-            let scene = structures.with_kind(kind)?;
+            let scene = structures.build_fresh(kind)?;
             let brute = kind == AccelKind::Brute;
             let rate = |rays: &[arbor::math::Ray]| {
                 let (rays, _) = if brute {

@@ -12,10 +12,11 @@
 //! are skipped; a tile takes well under a millisecond at these sizes), so the worker moves on at once.
 //! Images are published as 8-bit RGB on two watch channels (`render`, `overlay`) that any number of
 //! requests can wait on; each publication is also announced as an event. The server never waits for a
-//! pass: it only reads the last image published.
+//! pass: it only reads the last image published. The structure chart's benchmark holds the worker
+//! between passes ([`Frames::quiet`]) so that neither measures the other's load.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Instant;
 
 use arbor::film::Film;
@@ -102,6 +103,8 @@ pub struct Frames {
     /// The last overlay image.
     pub overlay: watch::Sender<Option<Arc<Image>>>,
     events: Events,
+    /// Held by each pass from its render to its publication, and by whoever needs the cores quiet.
+    quiet: Mutex<()>,
 }
 
 impl Frames {
@@ -116,6 +119,7 @@ impl Frames {
             render: watch::channel(None).0,
             overlay: watch::channel(None).0,
             events,
+            quiet: Mutex::new(()),
         });
         let worker = Arc::downgrade(&frames);
         std::thread::spawn(move || work(worker));
@@ -147,6 +151,12 @@ impl Frames {
         job.request.clone().map(|r| (job.version, r))
     }
 
+    /// Holds the worker between passes until the guard is dropped: a pass in flight ends (and is
+    /// published) first, and no other starts meanwhile.
+    pub fn quiet(&self) -> MutexGuard<'_, ()> {
+        self.quiet.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     /// Renders `request` (view `version`) pass by pass until it is done or `cancel` is set.
     fn run(&self, version: u64, request: &ViewRequest, cancel: &Arc<AtomicBool>) {
         let scene = self.structures.scene();
@@ -176,6 +186,7 @@ impl Frames {
         let last = *self.last_pass.lock().unwrap_or_else(|e| e.into_inner());
         let fast = last.is_some_and(|(size, ms)| size == (w, h) && ms < PREVIEW_UNDER_MS);
         if w * h >= PREVIEW_MIN_PIXELS && !fast {
+            let _quiet = self.quiet();
             let small = posed((w / 4).max(1), (h / 4).max(1));
             match render_camera(&scene, &small, &opts, &|_, _| {}) {
                 Ok((film, stats)) if !stale() => publish(
@@ -188,6 +199,7 @@ impl Frames {
             }
         }
         if let Some(view) = request.overlay {
+            let _quiet = self.quiet();
             match render_camera(&scene, &cam, &RenderOptions { debug: Some(view), ..opts.clone() }, &|_, _| {}) {
                 Ok((film, stats)) if !stale() => {
                     let mut image = self.image(version, None, &film, &stats, 1, Instant::now());
@@ -200,6 +212,7 @@ impl Frames {
         }
         let mut sum = vec![Color::ZERO; w as usize * h as usize];
         for k in 0..request.max_spp {
+            let _quiet = self.quiet();
             let (film, stats) =
                 match render_camera(&scene, &cam, &RenderOptions { seed: k as u64, ..opts.clone() }, &|_, _| {}) {
                     Ok(r) if !stale() => r,

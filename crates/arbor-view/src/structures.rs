@@ -109,6 +109,12 @@ impl Structures {
         Ok(scene)
     }
 
+    /// The scene under `kind` with default parameters, built now whether or not it was before, and not
+    /// kept (the benchmark's timed build).
+    pub fn build_fresh(&self, kind: AccelKind) -> arbor::Result<Arc<Scene>> {
+        self.build_reporting(&AccelConfig::from(kind), "benchmark")
+    }
+
     /// Every structure built so far: the current one first, then the others by kind.
     pub fn built(&self) -> Vec<(String, Arc<Scene>)> {
         let (config, scene) = self.current.read().unwrap_or_else(|e| e.into_inner()).clone();

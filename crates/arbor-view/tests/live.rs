@@ -347,7 +347,9 @@ fn the_benchmark_measures_every_structure_on_the_views_rays() {
     let server = start();
     let mut events = Events::open(&server);
     let (w, h) = (24, 16);
-    set_view(&server, &format!(r#"{{"camera": 0, "width": {w}, "height": {h}, "spp": 1}}"#));
+    // A view that goes on adding passes the whole time: the benchmark holds it.
+    let view = set_view(&server, &format!(r#"{{"camera": 0, "width": {w}, "height": {h}, "spp": 65536}}"#));
+    events.until_frame(view, 1);
     {
         let _hold = PoolHold::new();
         let r = post(&server, "/api/bench", "");
@@ -358,6 +360,12 @@ fn the_benchmark_measures_every_structure_on_the_views_rays() {
     }
     let seen = events.until(|e| e["type"] == "bench" && e["state"] != "running");
     assert_eq!(seen.last().unwrap()["state"], "done");
+    let first_row = seen.iter().position(|e| e.get("row").is_some()).unwrap();
+    assert!(
+        seen[first_row..].iter().all(|e| e["type"] != "frame"),
+        "no pass of the view renders while the benchmark measures"
+    );
+    events.until(|e| e["type"] == "frame" && e["view"] == view);
     let row_events: Vec<&Value> = seen.iter().filter(|e| e["type"] == "bench").filter_map(|e| e.get("row")).collect();
     let state = get(&server, "/api/bench").json();
     assert_eq!(state["state"], "done");
