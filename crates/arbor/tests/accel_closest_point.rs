@@ -11,10 +11,13 @@
 //! Each family declares how many of its queries must be ties (several primitives at the best
 //! distance), so that the tie rule is tested and not only the easy cases.
 
-use arbor_accel::accel::{AccelConfig, AccelKind, Nearest, PrimHit, Primitives, Structure};
-use arbor_accel::geometry::TriangleMesh;
-use arbor_accel::math::{Aabb, DVec3, Ray, Vec3};
+use arbor::accel::{AccelConfig, AccelKind, Nearest, PrimHit, Primitives, Structure};
+use arbor::geometry::TriangleMesh;
+use arbor::math::{Aabb, DVec3, Ray, Vec3};
 use proptest::prelude::*;
+
+mod common;
+use common::soups::{closed_cube, mesh_of, random_soup, Rng};
 
 /// Every kind with its defaults, then variants: one-primitive leaves, PLOC, deep octrees.
 fn configs() -> Vec<AccelConfig> {
@@ -106,50 +109,6 @@ fn check(case: &str, mesh: &TriangleMesh, queries: &[Query]) -> Asked {
     asked
 }
 
-/// xorshift64*: seeded, so a failure names a reproducible case.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
-    }
-    fn u32(&mut self) -> u32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 32) as u32
-    }
-    fn below(&mut self, n: usize) -> usize {
-        self.u32() as usize % n
-    }
-    fn f32(&mut self) -> f32 {
-        (self.u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn vec3(&mut self) -> Vec3 {
-        Vec3::new(self.f32(), self.f32(), self.f32())
-    }
-    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-        xs[self.below(xs.len())]
-    }
-}
-
-fn mesh_of(tris: &[[Vec3; 3]]) -> TriangleMesh {
-    TriangleMesh {
-        positions: tris.iter().flatten().copied().collect(),
-        indices: (0..tris.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect(),
-        ..Default::default()
-    }
-}
-
-fn random_soup(rng: &mut Rng, n: usize, extent: f32, tri_size: f32) -> Vec<[Vec3; 3]> {
-    (0..n)
-        .map(|_| {
-            let c = rng.vec3() * extent;
-            [0; 3].map(|_| c + (rng.vec3() - 0.5) * tri_size)
-        })
-        .collect()
-}
-
 /// `n` queries of random flavours around `mesh`: anywhere in its box grown by half, on a triangle (a
 /// random convex combination, so a hair off it after rounding), exactly on a vertex, on an edge's
 /// midpoint, far away; one in eight with a bound of 0.5, one in sixteen with a bound of 0.
@@ -234,38 +193,15 @@ fn closest_point_matches_brute_force_on_grid_vertices_and_edges() {
     check("grid", &mesh, &qs).require("grid", 4000, 0.9, 0.5);
 }
 
-/// A closed cube of side 2 around the origin, each face an `n` x `n` grid.
-fn closed_cube(n: u32) -> Vec<[Vec3; 3]> {
-    let mut tris = Vec::new();
-    let s = |i: u32| -1.0 + 2.0 * i as f32 / n as f32;
-    for axis in 0..3 {
-        for side in [-1.0f32, 1.0] {
-            let at = |i: u32, j: u32| {
-                let mut p = Vec3::splat(side);
-                p[(axis + 1) % 3] = s(i);
-                p[(axis + 2) % 3] = s(j);
-                p
-            };
-            for j in 0..n {
-                for i in 0..n {
-                    tris.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                    tris.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-                }
-            }
-        }
-    }
-    tris
-}
-
 #[test]
 fn closest_point_matches_brute_force_inside_and_on_a_closed_mesh() {
     let tris = closed_cube(6);
     let mesh = mesh_of(&tris);
     let mut rng = Rng::new(3);
     let mut qs = queries(&mesh, &mut rng, 2000);
-    // Inside, where every face is a candidate; the centre is a six-way tie of faces.
-    qs.extend((0..1500).map(|_| Query { p: ((rng.vec3() - 0.5) * 1.9).as_dvec3(), max_distance: f64::INFINITY }));
-    qs.push(Query { p: DVec3::ZERO, max_distance: f64::INFINITY });
+    // Inside the cube [0, 6]^3, where every face is a candidate; the centre is a six-way tie of faces.
+    qs.extend((0..1500).map(|_| Query { p: (rng.vec3() * 5.9 + 0.05).as_dvec3(), max_distance: f64::INFINITY }));
+    qs.push(Query { p: DVec3::splat(3.0), max_distance: f64::INFINITY });
     check("closed cube", &mesh, &qs).require("closed cube", 3500, 0.9, 0.15);
 }
 
