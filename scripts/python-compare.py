@@ -20,6 +20,14 @@ edge. trimesh's ray_triangle runs on --slow rays only.
 
 embreex and trimesh's embree path are single-threaded: their rows are the same on 1 and 2 threads.
 
+Closest points (--points per mesh, 0 skips them): half from surface points moved along the triangle's
+normal by up to 2% of the box's diagonal either way, half anywhere in the box grown by 20%, float64.
+Arbor's Mesh.closest_point, Open3D's RaycastingScene.compute_closest_points (when installed) and
+trimesh.proximity.closest_point (needs scipy; --slow-points points only: it is slow) in thousands of
+points per second; agreement: the share of --check points whose distance is within 1e-6 of the box's
+diagonal of the one Arbor's brute-force structure gives (every triangle tested; the pytest suite holds
+that one to a float64 NumPy brute force).
+
 Setup (a venv): pip install numpy trimesh rtree embreex open3d ./crates/arbor-py
 (Open3D needs libusb: apt-get install libusb-1.0-0). Run:
     scripts/python-compare.py --meshes /work/shared/meshes --rays 1000000 --runs 3
@@ -189,6 +197,68 @@ class Reference:
         return ok
 
 
+def query_points(v, f, n, seed):
+    """`n` float64 points: half near the surface (either side), half anywhere around the mesh."""
+    rng = np.random.default_rng(seed)
+    v = v.astype(np.float64)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    diag = np.linalg.norm(hi - lo)
+    t = f[rng.integers(0, len(f), n // 2)]
+    w = rng.dirichlet([1, 1, 1], len(t))
+    a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+    nrm = np.cross(b - a, c - a)
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+    near = np.einsum("ik,kij->ij", w, np.stack([a, b, c])) + nrm * rng.uniform(-0.02, 0.02, (len(t), 1)) * diag
+    pad = 0.2 * (hi - lo)
+    return np.concatenate([near, rng.uniform(lo - pad, hi + pad, (n - len(t), 3))]), diag
+
+
+def closest_points(args, name, v, f, m, tm, threads, rs):
+    """The closest-point section of one mesh: printed, and returned as rows."""
+    points, diag = query_points(v, f, args.points, seed=3)
+    n = len(points)
+    check = np.random.default_rng(4).choice(n, min(args.check, n), replace=False)
+    ref = ar.Mesh(v, f).build("brute").distance(points[check])
+    results = {}
+
+    def record(tool, th, secs, count, dist):
+        agree = np.abs(dist - ref[: len(dist)]) <= 1e-6 * diag
+        results[(tool, th)] = (count / secs / 1e3, float(agree.mean()), CPU[-1])
+
+    for th in threads:
+        secs, out = timed(lambda: m.closest_point(points, threads=th), args.runs)
+        record("arbor closest_point", th, secs, n, out["distance"][check])
+    if rs:
+        import open3d as o3d
+
+        for th in threads:
+            def o3d_closest():
+                return rs.compute_closest_points(o3d.core.Tensor(points.astype(np.float32)), nthreads=th)["points"].numpy()
+            secs, out = timed(o3d_closest, args.runs)
+            record("open3d compute_closest_points", th, secs, n, np.linalg.norm(out[check] - points[check], axis=1))
+    try:
+        import scipy  # noqa: F401  (trimesh.proximity needs it)
+
+        import trimesh
+
+        slow = check[: min(args.slow_points, len(check))]
+        t0, c0 = time.perf_counter(), time.process_time()
+        _, dist, _ = trimesh.proximity.closest_point(tm, points[slow])
+        secs = time.perf_counter() - t0
+        CPU.append((time.process_time() - c0) / secs)
+        for th in threads:
+            record("trimesh proximity (subset)", th, secs, len(slow), dist)
+    except ImportError:
+        print("   trimesh.proximity.closest_point: skipped, scipy is absent", flush=True)
+    print(f"-- closest points ({n} points, {len(check)} checked)", flush=True)
+    rows = []
+    for (tool, th), (kp, ag, cores) in results.items():
+        print(f"   {tool:30s} threads {th}: {kp:10.1f} kpoints/s  cores {cores:.2f}  agreement {100 * ag:.2f}%", flush=True)
+        rows.append({"mesh": name, "set": "closest points", "tool": tool, "threads": th, "kpoints": kp,
+                     "agreement": ag, "cores": cores})
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--meshes", default=os.environ.get("ARBOR_MESHES", "../shared/meshes"))
@@ -196,6 +266,8 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--check", type=int, default=1000, help="rays per set checked against the float64 brute force")
     ap.add_argument("--slow", type=int, default=2000, help="rays per set for trimesh's ray_triangle")
+    ap.add_argument("--points", type=int, default=100_000, help="closest-point queries per mesh (0: none)")
+    ap.add_argument("--slow-points", type=int, default=200, help="points for trimesh.proximity.closest_point")
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--json", help="write every number here too")
     args = ap.parse_args()
@@ -245,6 +317,8 @@ def main():
             builds["open3d"] = time.perf_counter() - t0
         print("build seconds: " + ", ".join(f"{k} {s:.3f}" for k, s in builds.items()), flush=True)
         rows.append({"mesh": name, "triangles": len(f), "builds": builds})
+        if args.points:
+            rows += closest_points(args, name, v, f, m, tm, threads, o3d and rs)
         tri_tm = trimesh.ray.ray_triangle.RayMeshIntersector(tm)
         for set_name, (o, d) in ray_sets(v, f, args.rays, seed=1).items():
             n = len(o)

@@ -7,7 +7,7 @@
 //! and one too large for `f32` is refused as non-finite (the OBJ reader refuses `1e99` so too).
 //! Anything that is not an array (a list, a tuple) goes through `numpy.asarray` first.
 
-use arbor::math::Vec3;
+use arbor::math::{DVec3, Vec3};
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::{PyArrayDescrMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -46,6 +46,14 @@ impl Rows<'_> {
         match self {
             Rows::F32(a) => a.nrows(),
             Rows::F64(a) => a.nrows(),
+        }
+    }
+    /// Row `i` as a vector of `f64`, exactly as given (a `float32` row widened).
+    #[inline]
+    pub fn get_f64(&self, i: usize) -> DVec3 {
+        match self {
+            Rows::F32(a) => DVec3::new(a[[i, 0]].into(), a[[i, 1]].into(), a[[i, 2]].into()),
+            Rows::F64(a) => DVec3::new(a[[i, 0]], a[[i, 1]], a[[i, 2]]),
         }
     }
     /// Row `i` as a vector of `f32`.
@@ -248,17 +256,23 @@ fn rows_of<T: Copy + Into<i128>>(
 /// coordinate `nan``).
 pub fn positions(vertices: &Floats<'_, 2>) -> PyResult<Vec<[f32; 3]>> {
     let rows = vertices.rows();
-    let mut out = Vec::with_capacity(rows.len());
+    finite_rows("vertices", &rows)?;
+    Ok((0..rows.len()).map(|i| rows.get(i).to_array()).collect())
+}
+
+/// Refuses the first coordinate of `rows` (the array `name`) that is not finite in `f32` (NaN,
+/// infinite, or a `float64` beyond `f32`'s range), in the mesh readers' words (`points[2, 1]:
+/// non-finite coordinate `nan``).
+pub fn finite_rows(name: &str, rows: &Rows<'_>) -> PyResult<()> {
     for i in 0..rows.len() {
         let p = rows.get(i);
         if let Some(k) = (0..3).find(|&k| !p[k].is_finite()) {
-            let shown = match &rows {
+            let shown = match rows {
                 Rows::F32(a) => format!("{:?}", a[[i, k]]),
                 Rows::F64(a) => format!("{:?}", a[[i, k]]),
             };
-            return Err(PyValueError::new_err(format!("vertices[{i}, {k}]: non-finite coordinate `{shown}`")));
+            return Err(PyValueError::new_err(format!("{name}[{i}, {k}]: non-finite coordinate `{shown}`")));
         }
-        out.push(p.to_array());
     }
-    Ok(out)
+    Ok(())
 }

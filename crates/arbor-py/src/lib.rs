@@ -1,13 +1,14 @@
 //! `arbor_rays`: Arbor's exact ray queries and renderer for Python, on NumPy arrays (PyO3 and the
 //! `numpy` crate, built by maturin as an abi3 wheel). A thin room over the library: meshes come from
 //! arrays (`arrays.rs`) or Arbor's own mesh readers, structures from arbor-accel's one factory and
-//! parameter parsing, queries are the structures' batch queries (`queries.rs`, `crossings.rs`), and
-//! `render` is the CLI's path (`render.rs`). The Python package (`python/arbor_rays`) adds the trimesh
-//! and Open3D adapters and the type stubs.
+//! parameter parsing, queries are the structures' batch queries (`queries.rs`, `crossings.rs`) on
+//! arguments read by `args.rs`, and `render` is the CLI's path (`render.rs`). The Python package
+//! (`python/arbor_rays`) adds the trimesh and Open3D adapters and the type stubs.
 //!
 //! Every query releases the GIL and runs on a rayon pool of the threads asked for; arrays are read in
 //! place (any float or integer dtype, any order) and never written.
 
+mod args;
 mod arrays;
 mod crossings;
 mod errors;

@@ -12,9 +12,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
 
-use crate::arrays::{floats_n3, ints_m3, per_ray, positions, scalar, triangles, Floats, PerRay};
+use crate::args::{check_threads, PointArgs, RayArgs};
+use crate::arrays::{floats_n3, ints_m3, positions, triangles};
 use crate::crossings::Collector;
-use crate::queries::{self, in_pool, RaySet};
+use crate::queries::{self, in_pool};
 
 /// A structure over the mesh, and the collecting one built from the same configuration when first
 /// needed (`crossings.rs`).
@@ -37,61 +38,7 @@ pub struct Mesh {
     built: RwLock<Option<Arc<Built>>>,
 }
 
-/// The arguments that describe rays, borrowed for one query.
-struct RayArgs<'py> {
-    origins: Floats<'py, 2>,
-    dirs: Floats<'py, 2>,
-    t_min: (f32, Option<Floats<'py, 1>>),
-    t_max: (f32, Option<Floats<'py, 1>>),
-}
-
-impl<'py> RayArgs<'py> {
-    fn read(
-        origins: &Bound<'py, PyAny>,
-        directions: &Bound<'py, PyAny>,
-        t_min: Option<&Bound<'py, PyAny>>,
-        t_max: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Self> {
-        let origins = floats_n3("origins", origins)?;
-        let dirs = floats_n3("directions", directions)?;
-        let n = origins.rows().len();
-        if dirs.rows().len() != n {
-            return Err(PyValueError::new_err(format!(
-                "origins has {n} rows but directions has {}: one of each per ray",
-                dirs.rows().len()
-            )));
-        }
-        let interval =
-            |name: &str, x: Option<&Bound<'py, PyAny>>, default: f32| -> PyResult<(f32, Option<Floats<'py, 1>>)> {
-                match x {
-                    None => Ok((default, None)),
-                    Some(x) if x.is_none() => Ok((default, None)),
-                    Some(x) => match per_ray(name, x, n)? {
-                        None => Ok((scalar(name, x)?, None)),
-                        Some(a) => Ok((default, Some(a))),
-                    },
-                }
-            };
-        let t_min = interval("t_min", t_min, 0.0)?;
-        let t_max = interval("t_max", t_max, f32::INFINITY)?;
-        Ok(RayArgs { origins, dirs, t_min, t_max })
-    }
-
-    fn set(&self) -> RaySet<'_> {
-        RaySet {
-            origins: self.origins.rows(),
-            dirs: self.dirs.rows(),
-            t_min: per_ray_values(&self.t_min),
-            t_max: per_ray_values(&self.t_max),
-        }
-    }
-}
-
-fn per_ray_values<'a>((x, a): &'a (f32, Option<Floats<'_, 1>>)) -> PerRay<'a> {
-    a.as_ref().map_or(PerRay::Scalar(*x), |a| a.values())
-}
-
-fn vec3s<'py>(py: Python<'py>, v: Vec<f32>) -> PyResult<Bound<'py, PyAny>> {
+fn vec3s<'py, T: numpy::Element>(py: Python<'py>, v: Vec<T>) -> PyResult<Bound<'py, PyAny>> {
     let n = v.len() / 3;
     Ok(PyArray1::from_vec(py, v).reshape([n, 3])?.into_any())
 }
@@ -162,6 +109,23 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// The closest points of `points` within `max_distance`, the arguments checked first.
+    fn closest_points(
+        &self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        max_distance: f64,
+        threads: Option<usize>,
+    ) -> PyResult<queries::ClosestPoints> {
+        let threads = check_threads(threads)?;
+        let args = PointArgs::read(points, max_distance)?;
+        let (rows, max_distance) = (args.rows(), args.max_distance);
+        self.on_main(py, threads, |s| queries::closest_points(s, rows, max_distance))?
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+}
+
 /// A dict of the given items.
 fn dict<'py>(py: Python<'py>, items: Vec<(&str, Bound<'py, PyAny>)>) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -169,14 +133,6 @@ fn dict<'py>(py: Python<'py>, items: Vec<(&str, Bound<'py, PyAny>)>) -> PyResult
         d.set_item(k, v)?;
     }
     Ok(d)
-}
-
-fn check_threads(threads: Option<usize>) -> PyResult<Option<usize>> {
-    match threads {
-        Some(0) => Err(PyValueError::new_err("threads must be at least 1 (None uses every core)")),
-        Some(n) if n > 1024 => Err(PyValueError::new_err(format!("threads={n} is more than 1024"))),
-        t => Ok(t),
-    }
 }
 
 #[pymethods]
@@ -392,6 +348,53 @@ impl Mesh {
         let p = floats_n3("points", points)?;
         let rows = p.rows();
         Ok(self.on_collector(py, threads, |s| queries::contains_points(s, rows))?.into_pyarray(py))
+    }
+
+    /// closest_point(points, *, max_distance=inf, threads=None) -> dict
+    ///
+    /// The point of the mesh nearest to each point, (N, 3) float32/float64 (read in float64 as
+    /// given; NaN, infinite or beyond float32's range raise ValueError). Returns a dict of arrays:
+    /// ``point`` (N, 3) float64 on the mesh, ``distance`` (N,) float64 (unsigned, in the mesh's
+    /// units), ``triangle`` (N,) int64, ``u``, ``v`` (N,) float64 barycentric weights of the
+    /// triangle's vertices 1 and 2. Only triangles within ``max_distance`` (inclusive) count: a point
+    /// with none has distance inf, triangle -1 and NaN point, u, v. Exactly what testing every
+    /// triangle gives, whatever the structure: the smallest distance, ties (a point nearest to a
+    /// shared vertex or edge) to the lowest triangle index. Runs on ``threads`` threads (None: every
+    /// core) with the GIL released.
+    #[pyo3(signature = (points, *, max_distance=f64::INFINITY, threads=None))]
+    fn closest_point<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        max_distance: f64,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.closest_points(py, points, max_distance, threads)?;
+        dict(
+            py,
+            vec![
+                ("point", vec3s(py, c.point)?),
+                ("distance", c.distance.into_pyarray(py).into_any()),
+                ("triangle", c.triangle.into_pyarray(py).into_any()),
+                ("u", c.u.into_pyarray(py).into_any()),
+                ("v", c.v.into_pyarray(py).into_any()),
+            ],
+        )
+    }
+
+    /// distance(points, *, max_distance=inf, threads=None) -> ndarray
+    ///
+    /// The unsigned distance from each point, (N, 3) float32/float64, to the mesh: (N,) float64, the
+    /// ``distance`` of ``closest_point`` (inf where no triangle is within ``max_distance``).
+    #[pyo3(signature = (points, *, max_distance=f64::INFINITY, threads=None))]
+    fn distance<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        max_distance: f64,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(self.closest_points(py, points, max_distance, threads)?.distance.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {

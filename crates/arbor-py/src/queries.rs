@@ -1,7 +1,8 @@
 //! The batch queries behind the Python methods, on plain Rust data (array views in, vectors out), run
 //! on a rayon pool of the threads asked for, in chunks of [`CHUNK`] rays: each chunk is one
 //! `intersect_many`/`occluded_many` call, so the BVH's interleaved two-ray traversal serves Python
-//! callers as it serves the renderer's camera rays. No query here takes the GIL.
+//! callers as it serves the renderer's camera rays; closest points likewise, in `f64` from the points
+//! as given. No query here takes the GIL.
 //!
 //! `t_min`: a ray with `t_min > 0` is queried from `origin + t_min * direction` (rounded to `f32`) over
 //! `(0, t_max - t_min)`, and its `t` reported from the given origin. Every query (closest, any, all,
@@ -11,7 +12,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use arbor::accel::{Hit, Structure};
+use arbor::accel::{ClosestPointUnsupported, Hit, Nearest, Structure};
 use arbor::geometry::TriangleMesh;
 use arbor::math::Ray;
 use rayon::prelude::*;
@@ -233,4 +234,59 @@ pub fn count_crossings(s: &Structure<Collector>, rays: RaySet<'_>) -> Vec<i64> {
 /// Whether each point is inside the closed mesh ([`crate::crossings::contains`]).
 pub fn contains_points(s: &Structure<Collector>, points: Rows<'_>) -> Vec<bool> {
     (0..points.len()).into_par_iter().with_min_len(64).map(|i| contains(s, points.get(i))).collect()
+}
+
+/// Closest points, one row per point; a point with nothing within the bound has distance `inf`,
+/// triangle -1 and NaN elsewhere.
+pub struct ClosestPoints {
+    /// The nearest point on the mesh, `3N` values.
+    pub point: Vec<f64>,
+    /// Its distance.
+    pub distance: Vec<f64>,
+    /// Its triangle.
+    pub triangle: Vec<i64>,
+    /// Barycentric weight of the triangle's vertex 1.
+    pub u: Vec<f64>,
+    /// Barycentric weight of its vertex 2.
+    pub v: Vec<f64>,
+}
+
+/// The closest point on the mesh of every point, within `max_distance` (`Structure::closest_point`:
+/// ties to the lowest triangle index), in chunks of [`CHUNK`] points.
+pub fn closest_points(
+    s: &Structure,
+    points: Rows<'_>,
+    max_distance: f64,
+) -> Result<ClosestPoints, ClosestPointUnsupported> {
+    // Whether the structure answers at all, asked once (an empty batch): every chunk then can.
+    s.closest_points_many(&[], max_distance, &mut [])?;
+    let n = points.len();
+    let mut out = ClosestPoints {
+        point: vec![f64::NAN; 3 * n],
+        distance: vec![f64::INFINITY; n],
+        triangle: vec![-1; n],
+        u: vec![f64::NAN; n],
+        v: vec![f64::NAN; n],
+    };
+    out.distance
+        .par_chunks_mut(CHUNK)
+        .zip(out.triangle.par_chunks_mut(CHUNK))
+        .zip(out.u.par_chunks_mut(CHUNK))
+        .zip(out.v.par_chunks_mut(CHUNK))
+        .zip(out.point.par_chunks_mut(3 * CHUNK))
+        .enumerate()
+        .for_each(|(c, ((((d, tri), u), v), pt))| {
+            let batch: Vec<_> = (c * CHUNK..c * CHUNK + d.len()).map(|i| points.get_f64(i)).collect();
+            let mut found: Vec<Option<Nearest>> = vec![None; batch.len()];
+            // Answers, as the empty batch above did.
+            let _ = s.closest_points_many(&batch, max_distance, &mut found);
+            for (j, f) in found.iter().enumerate() {
+                let Some(f) = f else { continue };
+                d[j] = f.distance();
+                tri[j] = f.prim as i64;
+                (u[j], v[j]) = (f.u, f.v);
+                pt[3 * j..3 * j + 3].copy_from_slice(&f.point.to_array());
+            }
+        });
+    Ok(out)
 }

@@ -1,11 +1,12 @@
-//! Brute force: every ray tests every primitive. The reference every other structure is checked against,
+//! Brute force: every ray tests every primitive (and every closest-point query weighs every primitive). The reference every other structure is checked against,
 //! and the baseline of `arbor bench`'s speedups.
 
 use std::time::Instant;
 
 use super::closest::ClosestHit;
-use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
-use crate::math::{Aabb, Ray};
+use super::nearest;
+use super::{Accel, AccelStats, Hit, Nearest, Primitives, TraversalCounts};
+use crate::math::{Aabb, DVec3, Ray};
 
 /// No structure at all; only the bounds are kept.
 #[derive(Debug, Clone)]
@@ -62,6 +63,14 @@ impl<P: Primitives + ?Sized> Accel<P> for BruteForce {
             }
         }
         best.hit()
+    }
+
+    fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest> {
+        nearest::query(p, max_dist2, 0.0, |best| {
+            for i in 0..self.len {
+                best.offer(i as u32, prims.closest_point(i, p));
+            }
+        })
     }
 
     fn boxes_at_depth(&self, _: &P, depth: usize) -> Vec<Aabb> {

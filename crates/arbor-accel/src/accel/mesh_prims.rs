@@ -2,12 +2,29 @@
 //! watertight test ([`intersect_triangle`]), so every structure over a mesh agrees with brute force on
 //! shared edges and vertices.
 //!
+//! A triangle's closest point is Ericson's ([`triangle_point`]), clamped into the triangle's bounds.
+//!
 //! Bounds are the box of the three corners. A corner with a NaN coordinate drops out of that box (the
 //! `min`/`max` of a NaN keeps the other operand), which is harmless: such a triangle is never hit.
 
-use super::{PrimHit, Primitives};
-use crate::geometry::{clip_triangle_bounds, intersect_triangle, triangle_overlaps_box, TriangleMesh};
-use crate::math::{Aabb, Ray};
+use super::{PrimHit, PrimPoint, Primitives};
+use crate::geometry::{
+    clip_triangle_bounds, closest_point_on_triangle_f64, intersect_triangle, triangle_overlaps_box, TriangleMesh,
+};
+use crate::math::{Aabb, DVec3, Ray, Vec3};
+
+/// The point of triangle `[a, b, c]` closest to `p`, or `None` for a triangle with a non-finite
+/// corner. The one function behind every structure's closest-point query over a mesh, whether the
+/// corners come from the mesh or from a BVH leaf's copy of them (the same values), so that all of them
+/// weigh the same numbers.
+#[inline]
+pub(crate) fn triangle_point(p: DVec3, [a, b, c]: [Vec3; 3]) -> Option<PrimPoint> {
+    if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+        return None;
+    }
+    let (point, u, v) = closest_point_on_triangle_f64(p, a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+    Some(PrimPoint { point, u, v })
+}
 
 impl Primitives for TriangleMesh {
     #[inline]
@@ -35,6 +52,14 @@ impl Primitives for TriangleMesh {
     fn clipped_bounds(&self, i: usize, b: &Aabb) -> Aabb {
         let [p, q, r] = self.triangle(i);
         clip_triangle_bounds(p, q, r, b)
+    }
+
+    fn closest_point(&self, i: usize, p: DVec3) -> Option<PrimPoint> {
+        triangle_point(p, self.triangle(i))
+    }
+
+    fn has_closest_point(&self) -> bool {
+        true
     }
 
     fn triangle_mesh(&self) -> Option<&TriangleMesh> {

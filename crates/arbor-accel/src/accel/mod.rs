@@ -1,6 +1,7 @@
 //! Acceleration structures. The public door is [`Structure`]: a structure built by an [`AccelConfig`]
 //! (which structure, and its `*Params`) over primitives it holds, a [`crate::geometry::TriangleMesh`] or
-//! anything that implements [`Primitives`], answering closest-hit and any-hit queries.
+//! anything that implements [`Primitives`], answering closest-hit and any-hit queries, and closest-point
+//! queries over primitives that can tell their closest point (triangle meshes).
 //!
 //! Every structure returns exactly the hit brute force returns: the smallest `t` in `(0, t_max)`, and
 //! among primitives hit at that same `t`, the one with the lowest index. Inside, structures store only
@@ -20,6 +21,7 @@ mod config;
 #[doc(hidden)]
 pub mod kdtree;
 mod mesh_prims;
+mod nearest;
 #[doc(hidden)]
 pub mod octree;
 mod params;
@@ -30,7 +32,7 @@ use std::fmt;
 use std::str::FromStr;
 use std::time::Duration;
 
-use crate::math::{Aabb, Ray, Vec3};
+use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 #[doc(hidden)]
 pub use brute::BruteForce;
@@ -41,6 +43,7 @@ pub use config::{AccelConfig, KindParam};
 #[doc(hidden)]
 pub use kdtree::KdTree;
 pub use kdtree::KdTreeParams;
+pub use nearest::{ClosestPointUnsupported, Nearest, PrimPoint};
 #[doc(hidden)]
 pub use octree::Octree;
 pub use octree::OctreeParams;
@@ -184,6 +187,18 @@ pub trait Primitives: Sync {
     fn clipped_bounds(&self, i: usize, b: &Aabb) -> Aabb {
         self.bounds(i).intersection(*b)
     }
+    /// The point of primitive `i` closest to `p`, inside [`Primitives::bounds`] (closest-point queries
+    /// prune by box distance and rely on it); `None` when `i` can never be the answer. Only asked when
+    /// [`Primitives::has_closest_point`] is true.
+    fn closest_point(&self, i: usize, p: DVec3) -> Option<PrimPoint> {
+        let _ = (i, p);
+        None
+    }
+    /// Whether [`Primitives::closest_point`] answers (false by default: [`Structure::closest_point`]
+    /// then refuses the query instead of answering wrongly).
+    fn has_closest_point(&self) -> bool {
+        false
+    }
     /// The triangle mesh these primitives are, when they are one (primitive `i` is triangle `i`): lets a
     /// structure keep the triangles' corners in its own leaf order and test them without going through
     /// [`Primitives::intersect`], with the same triangle test and so the same hits.
@@ -252,6 +267,10 @@ pub trait Accel<P: Primitives + ?Sized>: Send + Sync {
     /// its queries read), so `stats().max_depth` is the deepest level with a box. An octree leaves out
     /// its empty leaves (regions holding nothing).
     fn boxes_at_depth(&self, prims: &P, depth: usize) -> Vec<Aabb>;
+    /// The primitive nearest to `p` within squared distance `max_dist2`, its point nearest to `p` and
+    /// their squared distance; ties to the lowest index (see `nearest.rs`). Asked only of primitives
+    /// that answer [`Primitives::closest_point`].
+    fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest>;
     /// [`Accel::intersect`] for a batch: `out[i]` becomes the closest hit of `rays[i]` in
     /// `(0, t_max[i])`, the same hit as a query of its own. A structure may trace several rays at once
     /// (the BVH interleaves two); the default asks one query per ray.

@@ -1,13 +1,16 @@
 //! The public door: [`Structure`] holds the primitives it was built over (owned, or shared through an
 //! [`Arc`] as the renderer shares a mesh between its instances) together with the built structure, so
-//! a query can only ever be answered against those primitives.
+//! a query can only ever be answered against those primitives. Queries: closest hit and any hit of rays
+//! (one or a batch), and the closest point on the primitives to a point (`nearest.rs`).
 
 use std::fmt;
 use std::sync::Arc;
 
-use super::{Accel, AccelConfig, AccelKind, AccelStats, ConfigError, Hit, Primitives};
+use super::{
+    Accel, AccelConfig, AccelKind, AccelStats, ClosestPointUnsupported, ConfigError, Hit, Nearest, Primitives,
+};
 use crate::geometry::TriangleMesh;
-use crate::math::{Aabb, Ray};
+use crate::math::{Aabb, DVec3, Ray};
 
 /// An acceleration structure over primitives it holds: by default a [`TriangleMesh`], or anything
 /// that implements [`Primitives`].
@@ -117,6 +120,65 @@ impl<P: Primitives + ?Sized + Send + 'static> Structure<P> {
         self.accel.occluded_many(&self.prims, rays, t_max, out);
     }
 
+    /// The primitive nearest to `p`, its point nearest to `p` (in `f64`) and their squared distance,
+    /// among the primitives within `max_distance` (squared distance at most `max_distance²`; `inf` for
+    /// no bound): the smallest squared distance, ties to the lowest primitive index, exactly what
+    /// brute force returns whatever the structure. `None` when nothing is within the bound, for a
+    /// non-finite `p`, and for a NaN or negative `max_distance`. Triangles with a non-finite corner are
+    /// never the answer. An error, never a wrong answer, when the primitives cannot tell their closest
+    /// point ([`Primitives::has_closest_point`]; triangle meshes can).
+    ///
+    /// ```
+    /// use arbor_accel::accel::{AccelConfig, Structure};
+    /// use arbor_accel::geometry::TriangleMesh;
+    /// use arbor_accel::math::DVec3;
+    ///
+    /// // A unit square in the plane z = 0, as two triangles sharing the diagonal (0,0)-(1,1).
+    /// let mesh = TriangleMesh::from_arrays(
+    ///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+    ///     vec![[0, 1, 2], [0, 2, 3]],
+    /// )?;
+    /// let octree = Structure::build(&"octree".parse()?, mesh)?;
+    /// let above = octree.closest_point(DVec3::new(0.25, 0.75, 2.0), f64::INFINITY)?.unwrap();
+    /// assert_eq!((above.prim, above.point, above.dist2), (1, DVec3::new(0.25, 0.75, 0.0), 4.0));
+    /// // Beyond the corner (1, 1), which both triangles share: a tie, to the lower index.
+    /// let corner = octree.closest_point(DVec3::new(2.0, 2.0, 0.0), f64::INFINITY)?.unwrap();
+    /// assert_eq!((corner.prim, corner.point, corner.distance()), (0, DVec3::ONE.with_z(0.0), 2f64.sqrt()));
+    /// assert_eq!(octree.closest_point(DVec3::new(0.5, 0.5, 3.0), 2.0)?, None, "nothing within 2");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn closest_point(&self, p: DVec3, max_distance: f64) -> Result<Option<Nearest>, ClosestPointUnsupported> {
+        self.check_closest_point()?;
+        Ok(self.accel.closest_point(&self.prims, p, max_dist2(max_distance)))
+    }
+
+    /// [`Structure::closest_point`] for a batch: `out[i]` becomes the answer for `points[i]`.
+    ///
+    /// # Panics
+    /// When `points` and `out` differ in length.
+    pub fn closest_points_many(
+        &self,
+        points: &[DVec3],
+        max_distance: f64,
+        out: &mut [Option<Nearest>],
+    ) -> Result<(), ClosestPointUnsupported> {
+        assert_eq!(points.len(), out.len(), "a batch's points and answers differ in length");
+        self.check_closest_point()?;
+        let d2 = max_dist2(max_distance);
+        for (o, &p) in out.iter_mut().zip(points) {
+            *o = self.accel.closest_point(&self.prims, p, d2);
+        }
+        Ok(())
+    }
+
+    fn check_closest_point(&self) -> Result<(), ClosestPointUnsupported> {
+        if self.prims.has_closest_point() {
+            Ok(())
+        } else {
+            Err(ClosestPointUnsupported { kind: self.kind })
+        }
+    }
+
     /// Statistics of the built structure (nodes, leaves, depth, SAH cost, bytes, build time).
     pub fn stats(&self) -> AccelStats {
         self.accel.stats()
@@ -137,6 +199,15 @@ impl<P: Primitives + ?Sized + Send + 'static> fmt::Debug for Structure<P> {
             .field("primitives", &s.primitives)
             .field("nodes", &s.nodes)
             .finish_non_exhaustive()
+    }
+}
+
+/// The squared bound of a closest-point query: NaN (nothing within it) for a NaN or negative distance.
+fn max_dist2(max_distance: f64) -> f64 {
+    if max_distance >= 0.0 {
+        max_distance * max_distance
+    } else {
+        f64::NAN
     }
 }
 

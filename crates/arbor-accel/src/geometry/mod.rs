@@ -11,7 +11,7 @@ mod triangle4;
 mod triangle_box;
 mod triangle_clip;
 
-pub use closest_point::closest_point_on_triangle;
+pub use closest_point::{closest_point_on_triangle, closest_point_on_triangle_f64};
 pub use mesh::{MeshError, MeshReport, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;

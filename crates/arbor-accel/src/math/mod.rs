@@ -1,10 +1,10 @@
-//! Vector types (glam, single precision), rays, boxes and affine transforms.
+//! Vector types (glam, single precision; `DVec3` for closest-point queries), rays, boxes and affine transforms.
 
 mod aabb;
 mod ray;
 mod transform;
 
 pub use aabb::Aabb;
-pub use glam::{Mat3, Mat4, Vec2, Vec3};
+pub use glam::{DVec3, Mat3, Mat4, Vec2, Vec3};
 pub use ray::Ray;
 pub use transform::Transform;

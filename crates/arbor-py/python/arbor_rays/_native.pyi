@@ -80,6 +80,18 @@ class Mesh:
         """(N,) int64: the number of crossings intersect_all reports per ray, uncapped."""
     def contains(self, points: ArrayLike, *, threads: Optional[int] = None) -> npt.NDArray[np.bool_]:
         """(N,) bool: whether each (N, 3) point is inside the closed mesh (robust parity)."""
+    def closest_point(
+        self, points: ArrayLike, *, max_distance: float = ..., threads: Optional[int] = None
+    ) -> dict[str, np.ndarray]:
+        """The point of the mesh nearest to each (N, 3) point, among triangles within max_distance
+        (default inf): point (N, 3) float64, distance (N,) float64 (unsigned), triangle (N,) int64,
+        u, v (N,) float64 barycentric weights; inf, -1 and NaN where none is within the bound. Ties
+        to the lowest triangle index."""
+    def distance(
+        self, points: ArrayLike, *, max_distance: float = ..., threads: Optional[int] = None
+    ) -> npt.NDArray[np.float64]:
+        """(N,) float64: the unsigned distance from each (N, 3) point to the mesh (inf beyond
+        max_distance)."""
 
 def load_mesh(path: Union[str, "PathLike[str]"]) -> Mesh:
     """A mesh file (.ply, .obj, .off) read by Arbor's readers; OSError or a located ValueError."""

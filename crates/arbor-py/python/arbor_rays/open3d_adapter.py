@@ -3,7 +3,8 @@
 ``t_hit`` in units of each direction's length (inf on a miss) and ``geometry_ids``/``primitive_ids``
 ``INVALID_ID`` on a miss. The arrays are NumPy arrays, not ``open3d.core.Tensor``; Open3D is not
 needed. Unlike Open3D, queries may run from several Python threads at once, ``test_occlusions``
-honours ``tnear``, and hit points are on the triangle.
+honours ``tnear``, hit points are on the triangle, and ``compute_closest_points`` is exact (ties to the
+lowest triangle index of the scene).
 """
 
 import numpy as np
@@ -54,7 +55,8 @@ class RaycastingScene:
                 verts.append(v)
                 faces.append(np.asarray(f, dtype=np.int64) + offset)
                 offset += len(v)
-            self._mesh = Mesh(np.concatenate(verts), np.concatenate(faces))
+            self._v, self._f = np.concatenate(verts), np.concatenate(faces)
+            self._mesh = Mesh(self._v, self._f)
             self._mesh.build(self._kind, threads=self._threads, **self._params)
             self._first = np.asarray(first, dtype=np.int64)
         return self._mesh
@@ -124,3 +126,29 @@ class RaycastingScene:
         q = np.asarray(query_points)
         inside = self._scene().contains(q.reshape(-1, 3), threads=_threads(nthreads) or self._threads)
         return inside.astype(np.float32).reshape(q.shape[:-1])
+
+    def compute_closest_points(self, query_points, nthreads=0):
+        """The nearest point of the scene to each point (..., 3): ``points`` (..., 3) float32,
+        ``geometry_ids``, ``primitive_ids`` (...) uint32, ``primitive_uvs`` (..., 2) float32,
+        ``primitive_normals`` (..., 3) float32 (unit)."""
+        q = np.asarray(query_points)
+        shape = q.shape[:-1]
+        m = self._scene()
+        c = m.closest_point(q.reshape(-1, 3), threads=_threads(nthreads) or self._threads)
+        g, p = self._ids(c["triangle"])
+        a, b, t = (self._v[self._f[c["triangle"], k]].astype(np.float64) for k in range(3))
+        n = np.cross(b - a, t - a)
+        n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-300)
+        return {
+            "points": c["point"].astype(np.float32).reshape(shape + (3,)),
+            "geometry_ids": g.reshape(shape),
+            "primitive_ids": p.reshape(shape),
+            "primitive_uvs": np.stack([c["u"], c["v"]], axis=-1).astype(np.float32).reshape(shape + (2,)),
+            "primitive_normals": n.astype(np.float32).reshape(shape + (3,)),
+        }
+
+    def compute_distance(self, query_points, nthreads=0):
+        """The unsigned distance from each point (..., 3) to the scene: (...) float32."""
+        q = np.asarray(query_points)
+        d = self._scene().distance(q.reshape(-1, 3), threads=_threads(nthreads) or self._threads)
+        return d.astype(np.float32).reshape(q.shape[:-1])

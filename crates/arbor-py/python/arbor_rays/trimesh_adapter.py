@@ -7,6 +7,9 @@ once (a ray through a shared edge or vertex is not counted twice nor lost; see
 ``Mesh.intersect_all``), ``intersects_any`` is a true occlusion query, and ``contains_points`` uses
 the robust parity rule of ``Mesh.contains``. Locations are on the triangle hit (from its
 barycentric coordinates), as float64.
+
+``closest_point(mesh, points)`` is ``trimesh.proximity.closest_point`` (the same arguments and
+return convention) on an Arbor structure, exact and multi-threaded.
 """
 
 import numpy as np
@@ -95,3 +98,21 @@ class RayMeshIntersector:
         """Whether each point, (n, 3), is inside the mesh: (n,) bool (robust parity; see
         ``Mesh.contains``). Points on the surface may go either way."""
         return self.arbor_mesh.contains(np.asarray(points), threads=self._threads)
+
+    def closest_point(self, points):
+        """``trimesh.proximity.closest_point`` on this intersector's structure: see ``closest_point``."""
+        c = self.arbor_mesh.closest_point(np.asarray(points), threads=self._threads)
+        return c["point"], c["distance"], c["triangle"]
+
+
+def closest_point(mesh, points):
+    """The point of the mesh nearest to each point, as ``trimesh.proximity.closest_point(mesh,
+    points)`` returns it: ``closest`` (m, 3) float64, ``distance`` (m,) float64, ``triangle_id``
+    (m,) int64. ``mesh`` is a ``trimesh.Trimesh`` (its ``mesh.ray``'s structure is used when that is
+    a ``RayMeshIntersector``, else one is built for the call) or a ``RayMeshIntersector``. Exactly
+    what testing every triangle gives: ties (a point nearest to a shared vertex or edge) go to the
+    lowest triangle index."""
+    if not isinstance(mesh, RayMeshIntersector):
+        ray = getattr(mesh, "ray", None)
+        mesh = ray if isinstance(ray, RayMeshIntersector) else RayMeshIntersector(mesh)
+    return mesh.closest_point(points)

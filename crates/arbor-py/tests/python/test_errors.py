@@ -121,7 +121,7 @@ def test_help_shows_shapes_dtypes_and_units_and_the_stubs_name_what_exists():
     import ast
     import pathlib
 
-    for f in (ar.Mesh.intersect, ar.Mesh.intersect_all, ar.Mesh.occluded, ar.Mesh.contains, ar.render):
+    for f in (ar.Mesh.intersect, ar.Mesh.intersect_all, ar.Mesh.occluded, ar.Mesh.contains, ar.Mesh.closest_point, ar.render):
         doc = f.__doc__
         assert "(N, 3)" in doc or "(H, W, 3)" in doc, f.__name__
         assert "float32" in doc or "bool" in doc, f.__name__
@@ -135,5 +135,5 @@ def test_help_shows_shapes_dtypes_and_units_and_the_stubs_name_what_exists():
     methods = {n.name for n in next(n for n in tree.body if getattr(n, "name", "") == "Mesh").body if isinstance(n, ast.FunctionDef)}
     for m in methods - {"__init__"}:
         assert hasattr(ar.Mesh, m), m
-    for m in ("intersect", "occluded", "intersect_all", "count_crossings", "contains", "build", "stats"):
+    for m in ("intersect", "occluded", "intersect_all", "count_crossings", "contains", "closest_point", "distance", "build", "stats"):
         assert m in methods, m

@@ -1,5 +1,8 @@
-//! Helpers shared by the integration tests: where the shared real-world data lives.
+//! Helpers shared by the integration tests: where the shared real-world data lives, and random
+//! triangle soups (`soups.rs`).
 #![allow(dead_code)]
+
+pub mod soups;
 
 use std::path::{Path, PathBuf};
 

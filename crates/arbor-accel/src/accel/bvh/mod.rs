@@ -51,9 +51,10 @@ use recipe::Recipe;
 use wide::Kernel;
 pub use wide::{Node8, Wide};
 
+use super::nearest;
 use super::stats::StatsTally;
-use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
-use crate::math::{Aabb, Ray, Vec3};
+use super::{Accel, AccelStats, Hit, Nearest, Primitives, TraversalCounts};
+use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// Largest number of primitives in one leaf, whatever the parameters: a leaf of coincident centroids
 /// above it is split in the middle of its index range.
@@ -348,6 +349,10 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
 
     fn occluded_many(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
         wide::occluded_many_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
+    }
+
+    fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest> {
+        nearest::query(p, max_dist2, 0.0, |best| wide::closest_point(&self.wide, &self.prim_indices, prims, best))
     }
 
     fn stats(&self) -> AccelStats {

@@ -2,7 +2,8 @@
 //! Havran ("On building fast kd-trees for ray tracing, and on doing that in O(N log N)", RT 2006), with
 //! "perfect splits" (candidates from primitive bounds clipped to the node), traversal and intersection
 //! costs, an empty-space bonus and automatic termination; stored as pbrt's 8-byte `KdAccelNode`s and
-//! traversed front to back with a t-interval (pbrt-v4's `KdTreeAggregate::Intersect`).
+//! traversed front to back with a t-interval (pbrt-v4's `KdTreeAggregate::Intersect`); closest-point
+//! queries walk it nearest cell first (`nearest.rs`).
 //!
 //! Layout: nodes are written depth first, so an inner node's "below" child (the side of smaller
 //! coordinates) is the next node and only the "above" child's index is stored. A leaf of one primitive
@@ -38,6 +39,7 @@
 //! two or more. Queries are O(log N) on typical scenes.
 
 mod build;
+mod nearest;
 mod traverse;
 
 #[cfg(test)]
@@ -47,8 +49,8 @@ use std::time::{Duration, Instant};
 
 use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
 use super::stats::StatsTally;
-use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
-use crate::math::{Aabb, Ray};
+use super::{Accel, AccelStats, Hit, Nearest, Primitives, TraversalCounts};
+use crate::math::{Aabb, DVec3, Ray};
 
 /// Hard limit on the depth of any leaf, whatever the parameters; sizes the traversal stack.
 pub const MAX_DEPTH: usize = 64;
@@ -373,6 +375,10 @@ impl<P: Primitives + ?Sized> Accel<P> for KdTree {
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
         traverse::occluded(self, prims, ray, t_max)
+    }
+
+    fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest> {
+        nearest::closest_point(self, prims, p, max_dist2)
     }
 
     fn stats(&self) -> AccelStats {

@@ -3,7 +3,8 @@
 //! 2001; see `geometry::triangle_box`). Traversal visits the cells a ray crosses front to back and stops
 //! once the closest hit lies inside the current cell (Glassner 1984, "Space subdivision for fast ray
 //! tracing"; Revelles et al. 2000 order the children parametrically, here the at most four children a
-//! ray crosses are simply sorted by entry distance).
+//! ray crosses are simply sorted by entry distance). Closest-point queries visit cells nearest first
+//! (`nearest.rs`).
 //!
 //! Layout: one flat array of 8-byte [`Node`]s; an inner node stores the index of the first of its eight
 //! consecutive children (octant `k` has bit `a` of `k` set when it is the upper half on axis `a`), a
@@ -26,6 +27,7 @@
 //! cells (about 5 on the 70k-triangle Stanford bunny with the defaults, 3.5 with `fast_build`).
 
 mod build;
+mod nearest;
 mod traverse;
 mod validate;
 
@@ -33,8 +35,8 @@ use std::time::{Duration, Instant};
 
 use super::params::{ParamRange, ParamSet, ParamSpec, ParamValue};
 use super::stats::StatsTally;
-use super::{Accel, AccelStats, Hit, Primitives, TraversalCounts};
-use crate::math::{Aabb, Ray, Vec3};
+use super::{Accel, AccelStats, Hit, Nearest, Primitives, TraversalCounts};
+use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// Deepest level any parameters can ask for (cells 1/65536 of the root): sizes the traversal stack.
 pub const MAX_DEPTH: usize = 16;
@@ -296,6 +298,10 @@ impl<P: Primitives + ?Sized> Accel<P> for Octree {
 
     fn occluded(&self, prims: &P, ray: &Ray, t_max: f32) -> bool {
         traverse::traverse::<P, false, true>(self, prims, ray, t_max, &mut TraversalCounts::default()).is_some()
+    }
+
+    fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest> {
+        nearest::closest_point(self, prims, p, max_dist2)
     }
 
     fn stats(&self) -> AccelStats {

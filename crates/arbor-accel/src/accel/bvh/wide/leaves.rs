@@ -127,7 +127,7 @@ impl<P: Primitives + ?Sized> Leaves for PrimLeaves<'_, P> {
 
 /// The blocks of leaf `leaf` with the lanes to test in each (all four but in the last block).
 #[inline(always)]
-fn leaf_blocks(blocks: &[LeafBlock], leaf: Ref) -> impl Iterator<Item = (&LeafBlock, u32)> {
+pub(super) fn leaf_blocks(blocks: &[LeafBlock], leaf: Ref) -> impl Iterator<Item = (&LeafBlock, u32)> {
     let first = leaf.child as usize;
     let n = leaf.count as usize;
     blocks[first..first + n.div_ceil(4)].iter().enumerate().map(move |(k, b)| {

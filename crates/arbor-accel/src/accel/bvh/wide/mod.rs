@@ -29,7 +29,7 @@
 //! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in four kernels (`kernel.rs`), what a query does at a
 //! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
 //! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
-//! (`batch.rs`) and the any-hit query (`any_hit.rs`).
+//! (`batch.rs`), the any-hit query (`any_hit.rs`) and the closest-point query (`nearest.rs`).
 
 mod any_hit;
 mod batch;
@@ -40,6 +40,7 @@ mod collapse;
 mod dispatch;
 mod kernel;
 mod leaves;
+mod nearest;
 mod visit;
 mod walk;
 
@@ -51,6 +52,7 @@ pub(super) use collapse::PLAN_PARALLEL;
 pub(super) use kernel::Kernel;
 #[cfg(test)]
 pub(super) use kernel::{Avx2, Avx512};
+pub(super) use nearest::closest_point;
 
 use super::Node;
 use crate::accel::Primitives;
