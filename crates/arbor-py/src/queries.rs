@@ -13,7 +13,6 @@ use std::mem::MaybeUninit;
 use std::sync::{Arc, Mutex};
 
 use arbor::accel::{Hit, Structure};
-use arbor::geometry::TriangleMesh;
 use arbor::math::{Ray, Vec3};
 use rayon::prelude::*;
 
@@ -66,7 +65,9 @@ impl RaySet<'_> {
 
 /// The ray from `o` along `d` over `(t0, t1)` as queried (see the module documentation): the ray, its
 /// `t_max` from its own origin, and the `t` of that origin along the given ray.
-#[inline]
+// Always inlined: called per ray, its returned tuple would otherwise go through the stack, whose
+// narrow stores and wide reloads stall (seen in `perf annotate` of `RaySet::read`).
+#[inline(always)]
 fn as_queried(o: Vec3, d: Vec3, t0: f32, t1: f32) -> (Ray, f32, f32) {
     if t0.is_nan() {
         return (Ray::new(o, d), f32::NAN, 0.0);
@@ -87,6 +88,7 @@ struct Chunk {
     t_max: Vec<f32>,
     shift: Vec<f32>,
     hits: Vec<Option<Hit>>,
+    corners: Vec<[Vec3; 3]>,
 }
 
 impl Chunk {
@@ -98,6 +100,7 @@ impl Chunk {
             t_max: vec![0.0; CHUNK],
             shift: vec![0.0; CHUNK],
             hits: vec![None; CHUNK],
+            corners: vec![[Vec3::ZERO; 3]; CHUNK],
         }
     }
 }
@@ -157,15 +160,15 @@ pub struct Closest {
     pub point: Vec<f32>,
 }
 
-/// The unit normal of triangle `prim`.
-pub fn unit_normal(mesh: &TriangleMesh, prim: u32) -> [f32; 3] {
-    let [a, b, c] = mesh.triangle(prim as usize).map(|p| p.as_dvec3());
+/// The unit normal of the triangle of corners `[a, b, c]` (counter-clockwise side).
+pub fn unit_normal(corners: [Vec3; 3]) -> [f32; 3] {
+    let [a, b, c] = corners.map(|p| p.as_dvec3());
     (b - a).cross(c - a).normalize_or_zero().as_vec3().to_array()
 }
 
-/// The point of weights `(u, v)` on triangle `prim` (in `f64`, rounded once).
-pub fn surface_point(mesh: &TriangleMesh, prim: u32, u: f32, v: f32) -> [f32; 3] {
-    let [a, b, c] = mesh.triangle(prim as usize).map(|p| p.as_dvec3());
+/// The point of weights `(u, v)` on the triangle of corners `[a, b, c]` (in `f64`, rounded once).
+pub fn surface_point(corners: [Vec3; 3], u: f32, v: f32) -> [f32; 3] {
+    let [a, b, c] = corners.map(|p| p.as_dvec3());
     (a + (b - a) * u as f64 + (c - a) * v as f64).as_vec3().to_array()
 }
 
@@ -236,6 +239,14 @@ pub fn closest(s: &Structure, rays: RaySet<'_>, fields: Fields) -> Closest {
             let k = CHUNK.min(n - base);
             rays.read(base, k, chunk);
             s.intersect_many(&chunk.rays[..k], &chunk.t_max[..k], &mut chunk.hits[..k]);
+            if fields.normal || fields.point {
+                // The corners of every triangle hit, gathered in a loop of loads alone: on a large mesh
+                // they miss the cache, and this keeps many misses in flight where the arithmetic on
+                // each would keep a few.
+                for (c, h) in chunk.corners.iter_mut().zip(&chunk.hits[..k]) {
+                    *c = h.map_or([Vec3::ZERO; 3], |h| mesh.triangle(h.prim as usize));
+                }
+            }
             // Every row of every field asked for is written, hit or miss (`room`).
             for (j, h) in chunk.hits[..k].iter().enumerate() {
                 let (ht, tri, hu, hv) = match h {
@@ -253,10 +264,10 @@ pub fn closest(s: &Structure, rays: RaySet<'_>, fields: Fields) -> Closest {
                     o.v[j].write(hv);
                 }
                 if fields.normal {
-                    write3(&mut o.normal[3 * j..3 * j + 3], h.map_or([0.0; 3], |h| unit_normal(mesh, h.prim)));
+                    write3(&mut o.normal[3 * j..3 * j + 3], h.map_or([0.0; 3], |_| unit_normal(chunk.corners[j])));
                 }
                 if fields.point {
-                    let p = h.map_or([0.0; 3], |h| surface_point(mesh, h.prim, h.u, h.v));
+                    let p = h.map_or([0.0; 3], |h| surface_point(chunk.corners[j], h.u, h.v));
                     write3(&mut o.point[3 * j..3 * j + 3], p);
                 }
             }
@@ -319,7 +330,7 @@ pub fn all_hits(s: &Structure<Collector>, rays: RaySet<'_>, max_hits: usize) -> 
                     part.t.push(h.t + s0);
                     part.u.push(h.u);
                     part.v.push(h.v);
-                    part.point.extend(surface_point(mesh, h.prim, h.u, h.v));
+                    part.point.extend(surface_point(mesh.triangle(h.prim as usize), h.u, h.v));
                 }
             }
             part
