@@ -3,6 +3,13 @@
 //! `intersect_many`/`occluded_many` call, so the BVH's interleaved two-ray traversal serves Python
 //! callers as it serves the renderer's camera rays. No query here takes the GIL.
 //!
+//! Costs outside the traversal, kept small because a closest-hit query of a coherent ray costs only
+//! about a thousand instructions: each chunk's rays are read one argument at a time into buffers a
+//! task reuses ([`Chunk`]); the closest-hit outputs are written once each, into uninitialised room
+//! (no zeroing pass on the calling thread), and only those asked for ([`Fields`]): a normal or a
+//! point reads the triangle's corners from the mesh, a cache miss per hit on a large mesh, so the
+//! corners of a chunk's hits are gathered in a loop of their own that keeps many misses in flight.
+//!
 //! `t_min`: a ray with `t_min > 0` is queried from `origin + t_min * direction` (rounded to `f32`) over
 //! `(0, t_max - t_min)`, and its `t` reported from the given origin. Every query (closest, any, all,
 //! counts) uses that same ray, so their answers agree with each other; a negative `t_min` is 0 (rays
