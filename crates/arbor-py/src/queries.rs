@@ -179,12 +179,6 @@ pub fn surface_point(corners: [Vec3; 3], u: f32, v: f32) -> [f32; 3] {
     (a + (b - a) * u as f64 + (c - a) * v as f64).as_vec3().to_array()
 }
 
-/// Room for `n` values if `on`, else none: uninitialised, as [`closest`] writes every value (no pass
-/// over the memory before the query, and each task touches the pages of its own rows).
-fn room<T>(on: bool, n: usize) -> Vec<T> {
-    Vec::with_capacity(if on { n } else { 0 })
-}
-
 /// The first `len` values of `v`'s room (`len` is 0 or what it was made with) in pieces of
 /// `width * CHUNK` values, one per chunk of `chunks`: empty pieces for a field not asked for.
 fn pieces<T>(v: &mut Vec<T>, len: usize, width: usize, chunks: usize) -> impl Iterator<Item = &mut [MaybeUninit<T>]> {
@@ -213,17 +207,20 @@ fn write3(row: &mut [MaybeUninit<f32>], x: [f32; 3]) {
 /// The closest hit of every ray, with the outputs of `fields`.
 pub fn closest(s: &Structure, rays: RaySet<'_>, fields: Fields) -> Closest {
     let n = rays.len();
+    // Room for each field asked for, uninitialised: the loop below writes every value (no pass over
+    // the memory before the query, and each task touches the pages of its own rows).
     let len = |on: bool, width: usize| if on { width * n } else { 0 };
     let mut out = Closest {
-        t: room(fields.t, n),
-        triangle: room(fields.triangle, n),
-        u: room(fields.uv, n),
-        v: room(fields.uv, n),
-        normal: room(fields.normal, 3 * n),
-        point: room(fields.point, 3 * n),
+        t: Vec::with_capacity(len(fields.t, 1)),
+        triangle: Vec::with_capacity(len(fields.triangle, 1)),
+        u: Vec::with_capacity(len(fields.uv, 1)),
+        v: Vec::with_capacity(len(fields.uv, 1)),
+        normal: Vec::with_capacity(len(fields.normal, 3)),
+        point: Vec::with_capacity(len(fields.point, 3)),
     };
     let mesh = s.primitives().as_ref();
     let chunks = n.div_ceil(CHUNK);
+    // The pieces borrow `out` until every row is written.
     {
         let mut t = pieces(&mut out.t, len(fields.t, 1), 1, chunks);
         let mut triangle = pieces(&mut out.triangle, len(fields.triangle, 1), 1, chunks);
@@ -254,7 +251,7 @@ pub fn closest(s: &Structure, rays: RaySet<'_>, fields: Fields) -> Closest {
                     *c = h.map_or([Vec3::ZERO; 3], |h| mesh.triangle(h.prim as usize));
                 }
             }
-            // Every row of every field asked for is written, hit or miss (`room`).
+            // Every row of every field asked for is written, hit or miss.
             for (j, h) in chunk.hits[..k].iter().enumerate() {
                 let (ht, tri, hu, hv) = match h {
                     Some(h) => (h.t + chunk.shift[j], h.prim as i64, h.u, h.v),
