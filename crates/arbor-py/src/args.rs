@@ -94,3 +94,17 @@ pub fn check_threads(threads: Option<usize>) -> PyResult<Option<usize>> {
         t => Ok(t),
     }
 }
+
+/// The outputs of `intersect`, in the order its dict lists them.
+const FIELDS: [&str; 6] = ["t", "triangle", "u", "v", "normal", "point"];
+
+/// The fields asked for (every one for `None`), in [`FIELDS`]' order; an unknown name is refused.
+pub fn field_names(fields: Option<Vec<String>>) -> PyResult<Vec<&'static str>> {
+    let Some(fields) = fields else { return Ok(FIELDS.to_vec()) };
+    if let Some(bad) = fields.iter().find(|f| !FIELDS.contains(&f.as_str())) {
+        return Err(PyValueError::new_err(format!(
+            "fields: unknown field `{bad}` (the fields are t, triangle, u, v, normal, point)"
+        )));
+    }
+    Ok(FIELDS.into_iter().filter(|n| fields.iter().any(|f| f == n)).collect())
+}

@@ -64,6 +64,29 @@ impl Rows<'_> {
             Rows::F64(a) => Vec3::new(a[[i, 0]] as f32, a[[i, 1]] as f32, a[[i, 2]] as f32),
         }
     }
+    /// Rows `base..base + out.len()` into `out`, in one pass (a C-ordered array as a plain slice).
+    #[inline]
+    pub fn read(&self, base: usize, out: &mut [Vec3]) {
+        fn rows<T: Copy>(a: &ArrayView2<'_, T>, base: usize, out: &mut [Vec3], f: impl Fn(T) -> f32) {
+            match a.as_slice() {
+                Some(s) => {
+                    let s = &s[3 * base..3 * (base + out.len())];
+                    for (o, r) in out.iter_mut().zip(s.chunks_exact(3)) {
+                        *o = Vec3::new(f(r[0]), f(r[1]), f(r[2]));
+                    }
+                }
+                None => {
+                    for (i, o) in (base..).zip(out.iter_mut()) {
+                        *o = Vec3::new(f(a[[i, 0]]), f(a[[i, 1]]), f(a[[i, 2]]));
+                    }
+                }
+            }
+        }
+        match self {
+            Rows::F32(a) => rows(a, base, out, |x| x),
+            Rows::F64(a) => rows(a, base, out, |x| x as f32),
+        }
+    }
 }
 
 /// A per-ray parameter: one value for every ray, or one each.
@@ -85,6 +108,16 @@ impl PerRay<'_> {
             PerRay::Scalar(x) => *x,
             PerRay::F32(a) => a[i],
             PerRay::F64(a) => a[i] as f32,
+        }
+    }
+    /// The values for rays `base..base + out.len()`, into `out`.
+    #[inline]
+    pub fn read(&self, base: usize, out: &mut [f32]) {
+        let range = base..base + out.len();
+        match self {
+            PerRay::Scalar(x) => out.fill(*x),
+            PerRay::F32(a) => out.iter_mut().zip(range).for_each(|(o, i)| *o = a[i]),
+            PerRay::F64(a) => out.iter_mut().zip(range).for_each(|(o, i)| *o = a[i] as f32),
         }
     }
 }

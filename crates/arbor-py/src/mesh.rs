@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
 
-use crate::args::{check_threads, PointArgs, RayArgs};
+use crate::args::{check_threads, field_names, PointArgs, RayArgs};
 use crate::arrays::{floats_n3, ints_m3, positions, triangles};
 use crate::crossings::Collector;
 use crate::queries::{self, in_pool};
@@ -216,7 +216,7 @@ impl Mesh {
         Ok(PyArray1::from_vec(py, v).reshape([m, 3])?.into_any())
     }
 
-    /// intersect(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> dict
+    /// intersect(origins, directions, t_min=0.0, t_max=inf, *, threads=None, fields=None) -> dict
     ///
     /// The closest hit of each ray ``origins[i] + t * directions[i]``, ``t`` in ``(t_min, t_max)``:
     /// origins and directions (N, 3) float32/float64, directions of any length (``t`` is in units of
@@ -224,9 +224,12 @@ impl Mesh {
     /// (inf on a miss), ``triangle`` (N,) int64 (-1), ``u``, ``v`` (N,) float32 barycentric weights of
     /// the triangle's vertices 1 and 2 (0), ``normal`` (N, 3) float32 unit geometric normal on the
     /// counter-clockwise side (0), ``point`` (N, 3) float32 the hit point on the triangle (0). Ties
-    /// go to the lowest triangle index. Runs on ``threads`` threads (None: every core) with the GIL
+    /// go to the lowest triangle index. ``fields``, a list of those names, limits the dict to them
+    /// and the work to what they need (None: all; ``normal`` and ``point`` cost a read of the
+    /// triangle's corners per hit). Runs on ``threads`` threads (None: every core) with the GIL
     /// released.
-    #[pyo3(signature = (origins, directions, t_min=None, t_max=None, *, threads=None))]
+    #[pyo3(signature = (origins, directions, t_min=None, t_max=None, *, threads=None, fields=None))]
+    #[allow(clippy::too_many_arguments)]
     fn intersect<'py>(
         &self,
         py: Python<'py>,
@@ -235,22 +238,30 @@ impl Mesh {
         t_min: Option<&Bound<'py, PyAny>>,
         t_max: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
+        fields: Option<Vec<String>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let threads = check_threads(threads)?;
+        let names = field_names(fields)?;
+        let asked = |n: &str| names.contains(&n);
+        let wanted = queries::Fields {
+            t: asked("t"),
+            triangle: asked("triangle"),
+            uv: asked("u") || asked("v"),
+            normal: asked("normal"),
+            point: asked("point"),
+        };
         let args = RayArgs::read(origins, directions, t_min, t_max)?;
         let rays = args.set();
-        let c = self.on_main(py, threads, |s| queries::closest(s, rays))?;
-        dict(
-            py,
-            vec![
-                ("t", c.t.into_pyarray(py).into_any()),
-                ("triangle", c.triangle.into_pyarray(py).into_any()),
-                ("u", c.u.into_pyarray(py).into_any()),
-                ("v", c.v.into_pyarray(py).into_any()),
-                ("normal", vec3s(py, c.normal)?),
-                ("point", vec3s(py, c.point)?),
-            ],
-        )
+        let c = self.on_main(py, threads, |s| queries::closest(s, rays, wanted))?;
+        let items = vec![
+            ("t", c.t.into_pyarray(py).into_any()),
+            ("triangle", c.triangle.into_pyarray(py).into_any()),
+            ("u", c.u.into_pyarray(py).into_any()),
+            ("v", c.v.into_pyarray(py).into_any()),
+            ("normal", vec3s(py, c.normal)?),
+            ("point", vec3s(py, c.point)?),
+        ];
+        dict(py, items.into_iter().filter(|(k, _)| asked(k)).collect())
     }
 
     /// occluded(origins, directions, t_min=0.0, t_max=inf, *, threads=None) -> ndarray

@@ -1,7 +1,7 @@
 """Type stubs of the extension module (Rust, PyO3). Shapes: N rays, M triangles, K crossings."""
 
 from os import PathLike
-from typing import Any, Optional, Union
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -42,10 +42,12 @@ class Mesh:
         t_max: Optional[PerRay] = None,
         *,
         threads: Optional[int] = None,
+        fields: Optional[Sequence[str]] = None,
     ) -> dict[str, np.ndarray]:
         """Closest hits in (t_min, t_max), t in units of each direction's length: t (N,) float32 (inf
         on a miss), triangle (N,) int64 (-1), u, v (N,) float32, normal (N, 3) float32 (unit),
-        point (N, 3) float32 (on the triangle)."""
+        point (N, 3) float32 (on the triangle). fields: the names to compute and return (None: all;
+        normal and point read the triangle's corners per hit)."""
     def occluded(
         self,
         origins: ArrayLike,

@@ -82,7 +82,8 @@ class RaycastingScene:
         ``primitive_uvs`` (..., 2) float32, ``primitive_normals`` (..., 3) float32 (unit)."""
         shape, o, d = self._split(rays)
         m = self._scene()
-        c = m.intersect(o, d, threads=_threads(nthreads) or self._threads)
+        fields = ["t", "triangle", "u", "v", "normal"]
+        c = m.intersect(o, d, threads=_threads(nthreads) or self._threads, fields=fields)
         g, p = self._ids(c["triangle"])
         return {
             "t_hit": c["t"].reshape(shape),

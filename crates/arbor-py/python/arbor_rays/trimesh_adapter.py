@@ -54,7 +54,7 @@ class RayMeshIntersector:
     def intersects_first(self, ray_origins, ray_directions, **kwargs):
         """Index of the first triangle each ray hits, (n,) int64, -1 where it hits none."""
         o, d = self._rays(ray_origins, ray_directions)
-        return self.arbor_mesh.intersect(o, d, threads=self._threads)["triangle"]
+        return self.arbor_mesh.intersect(o, d, threads=self._threads, fields=["triangle"])["triangle"]
 
     def intersects_any(self, ray_origins, ray_directions, **kwargs):
         """Whether each ray hits the surface, (n,) bool (an any-hit query)."""
@@ -80,9 +80,10 @@ class RayMeshIntersector:
             a = m.intersect_all(o, d, max_hits=max_hits, threads=self._threads)
             tri, ray, loc = a["triangle"], a["ray"], a["point"]
         else:
-            c = m.intersect(o, d, threads=self._threads)
+            fields = ["triangle", "point"] if return_locations else ["triangle"]
+            c = m.intersect(o, d, threads=self._threads, fields=fields)
             ray = np.flatnonzero(c["triangle"] >= 0)
-            tri, loc = c["triangle"][ray], c["point"][ray]
+            tri, loc = c["triangle"][ray], c["point"][ray] if return_locations else None
         if return_locations:
             return tri, ray.astype(np.int64), loc.astype(np.float64)
         return tri, ray.astype(np.int64)

@@ -52,6 +52,7 @@ def test_bad_rays_and_arguments_raise_value_errors():
         (lambda: m.intersect_all(o, d, 0.0, np.zeros((5, 1))), "t_max must be a number or have shape (5,), one per ray, got (5, 1)"),
         (lambda: m.intersect(o, d, "near"), "t_min must be a number or an array of one per ray"),
         (lambda: m.intersect(o, d, threads=0), "threads must be at least 1 (None uses every core)"),
+        (lambda: m.intersect(o, d, fields=["t", "depth"]), "fields: unknown field `depth` (the fields are t, triangle, u, v, normal, point)"),
         (lambda: m.contains(o[:, :1]), "points must have shape (N, 3), got (5, 1)"),
         (lambda: m.build("quadtree"), "unknown acceleration structure 'quadtree' (expected one of: brute, octree, kdtree, bvh-median, bvh-sah, bvh-bottom-up)"),
         (lambda: m.build("octree", depth=99), "parameter 'depth': 99 is outside its range 0..=16"),

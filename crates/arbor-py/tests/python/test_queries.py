@@ -43,6 +43,25 @@ def test_every_structure_gives_the_same_answers_bit_for_bit(kind):
         assert np.array_equal(x[key], y[key]), key
 
 
+def test_fields_limit_the_answer_to_the_outputs_asked_for():
+    v, f = soup(300, seed=20)
+    o, d = random_rays(1000, seed=21)  # not a whole number of the queries' chunks of 256 rays
+    m = ar.Mesh(v, f)
+    t_min = np.random.default_rng(22).uniform(0.0, 2.0, len(o)).astype(np.float32)
+    every = m.intersect(o, d, t_min)
+    assert list(every) == ["t", "triangle", "u", "v", "normal", "point"]
+    miss = every["triangle"] < 0
+    assert 100 < miss.sum() < 900
+    assert np.all(np.isinf(every["t"][miss]))
+    for key in ("u", "v", "normal", "point"):
+        assert not np.any(every[key][miss]), f"a miss has a nonzero {key}"
+    for fields in (["triangle"], ["point", "t"], ["v"], ["normal", "u", "triangle"], []):
+        got = m.intersect(o, d, t_min, fields=fields)
+        assert list(got) == [k for k in every if k in fields]
+        for key in got:
+            assert np.array_equal(got[key], every[key]), key
+
+
 def test_any_hit_is_an_occlusion_query_within_its_interval():
     v, f = soup(300, seed=5)
     o, d = random_rays(2000, seed=6)
