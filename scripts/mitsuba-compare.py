@@ -332,14 +332,25 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
     return read_exr(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
 
+def bitmap_io(io):
+    """Runs `io` (a Mitsuba Bitmap read or write) on at least 2 Dr.Jit threads: with `dr.set_thread_count(1)`
+    Bitmap's EXR reader and writer never return (Mitsuba 3.9.1, Dr.Jit 1.5.0), which hung `--threads 1`."""
+    threads = dr.thread_count()
+    dr.set_thread_count(max(threads, 2))
+    try:
+        return io()
+    finally:
+        dr.set_thread_count(threads)
+
+
 def read_exr(path):
     mi.set_variant(REF_VARIANT)
-    return np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3]
+    return bitmap_io(lambda: np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3])
 
 
 def write_exr(path, img):
     mi.set_variant(REF_VARIANT)
-    mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)).write(str(path))
+    bitmap_io(lambda: mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)).write(str(path)))
 
 
 def rmse(a, b):
