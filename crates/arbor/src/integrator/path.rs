@@ -402,3 +402,192 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 fn luminance(c: Color) -> f32 {
     crate::tonemap::luminance(c).max(0.0)
 }
+
+/// EXPERIMENT (issue 34 prototype): one live path of a wavefront.
+struct Lane {
+    ray: Ray,
+    beta: Color,
+    l: Color,
+    last: Option<(Vec3, f32)>,
+    bounce: u32,
+    slot: usize,
+}
+
+impl PathTracer<'_> {
+    /// EXPERIMENT: whether the wavefront covers the scene (no planes, textures, layers, media, course roulette).
+    pub fn wavefront_covers(&self) -> bool {
+        let s = self.scene;
+        s.geometry.planes.is_empty()
+            && self.options.roulette != Roulette::Course
+            && s.object_materials.iter().all(|&m| s.materials[m].layer.is_none())
+            && (0..s.object_materials.len() as u32).all(|o| !s.has_textures(o))
+    }
+
+    /// EXPERIMENT: the radiance of every camera ray of a batch, `out[i]` for `rays[i]` with hit `hits[i]`.
+    pub fn li_batch(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        streams: &mut [SampleStream],
+        log: &mut RayLog,
+        out: &mut Vec<Color>,
+    ) {
+        let scene = self.scene;
+        let g = &scene.geometry;
+        let o = self.options;
+        let max_bounces = if o.roulette == Roulette::Off { scene.max_depth } else { MAX_BOUNCES };
+        out.clear();
+        out.resize(rays.len(), Color::ZERO);
+        let mut lanes: Vec<Lane> = rays
+            .iter()
+            .enumerate()
+            .map(|(slot, r)| Lane { ray: *r, beta: Color::ONE, l: Color::ZERO, last: None, bounce: 0, slot })
+            .collect();
+        let mut hit: Vec<Option<Hit>> = hits.to_vec();
+        log.rays += rays.len() as u64;
+        let (mut sh_rays, mut sh_tmax, mut sh_add, mut sh_occ) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut next_rays, mut next_tmax) = (Vec::new(), Vec::new());
+        let mut alive = Vec::new();
+        while !lanes.is_empty() {
+            sh_rays.clear();
+            sh_tmax.clear();
+            sh_add.clear();
+            alive.clear();
+            for (k, lane) in lanes.iter_mut().enumerate() {
+                let sample = &mut streams[lane.slot];
+                let keep = self.shade_lane(lane, hit[k], sample, max_bounces, log, &mut |ray, t, c| {
+                    sh_rays.push(ray);
+                    sh_tmax.push(t);
+                    sh_add.push((k, c));
+                });
+                alive.push(keep);
+            }
+            // Shadow rays of this step, all at once; their light added in each path's order.
+            sh_occ.clear();
+            sh_occ.resize(sh_rays.len(), false);
+            g.top.occluded_many(&g.objects, &sh_rays, &sh_tmax, &mut sh_occ);
+            for (j, &(k, c)) in sh_add.iter().enumerate() {
+                if !(sh_rays[j].is_valid() && sh_occ[j]) {
+                    lanes[k].l += c;
+                }
+            }
+            let mut k = 0;
+            lanes.retain(|lane| {
+                k += 1;
+                if !alive[k - 1] {
+                    out[lane.slot] = lane.l;
+                }
+                alive[k - 1]
+            });
+            next_rays.clear();
+            next_rays.extend(lanes.iter().map(|l| l.ray));
+            next_tmax.clear();
+            next_tmax.resize(next_rays.len(), f32::INFINITY);
+            hit.clear();
+            hit.resize(next_rays.len(), None);
+            g.top.intersect_many(&g.objects, &next_rays, &next_tmax, &mut hit);
+            for (h, r) in hit.iter_mut().zip(&next_rays) {
+                if !r.is_valid() {
+                    *h = None;
+                }
+            }
+        }
+    }
+
+    /// EXPERIMENT: one vertex of a lane's path: its light, its shadow rays (`shadow(ray, t_max, light, lane)`),
+    /// and its next ray; false when the path ends.
+    #[allow(clippy::too_many_arguments)]
+    fn shade_lane(
+        &self,
+        lane: &mut Lane,
+        hit: Option<Hit>,
+        sample: &mut SampleStream,
+        max_bounces: u32,
+        log: &mut RayLog,
+        shadow: &mut dyn FnMut(Ray, f32, Color),
+    ) -> bool {
+        let scene = self.scene;
+        let o = self.options;
+        let ray = lane.ray;
+        let Some(h) = hit else {
+            let w = lane.last.map_or(1.0, |(from, pdf)| {
+                self.met_light_weight(scene.environment_light, from, ray.dir.normalize(), pdf)
+            });
+            lane.l += lane.beta * self.miss(&ray, lane.bounce) * w;
+            return false;
+        };
+        let s = scene.surface(&ray, &h);
+        let m = scene.material(&s);
+        let emitted = scene.emitted(&s, -ray.dir);
+        if emitted != Color::ZERO {
+            let w = lane.last.map_or(1.0, |(from, pdf)| {
+                self.met_light_weight(scene.light_of(s.object), from, ray.dir.normalize(), pdf)
+            });
+            lane.l += lane.beta * emitted * w;
+        }
+        let (kd, ks) = (m.diffuse, m.specular);
+        let d = ray.dir.normalize();
+        let wo = -d;
+        let front = d.dot(s.ng) < 0.0;
+        let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
+        let brdf = &self.brdfs[s.material];
+        let local = front || !m.transmits();
+        let has_brdf = local && (kd != Color::ZERO || ks != Color::ZERO);
+        let at = Vertex { s: &s, ns, wo, kd, ks, brdf, f: brdf.constant(kd, ks), p_brdf: 1.0, time: ray.time };
+        let beta = lane.beta;
+        if has_brdf {
+            let origin = spawn_origin(scene.offset, &s, ng);
+            let pick = if self.several { sample.padded_1d() } else { sample.rng.next_f32() };
+            let u = sample.padded_2d();
+            if o.next_event {
+                let mut one = |i: usize, u: Vec2, chosen: f32| {
+                    let light = &scene.lights[i];
+                    let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
+                    log.rays += 1;
+                    let (sr, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, self.on_surface[i]);
+                    let w = if o.mis && ls.pdf > 0.0 {
+                        power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
+                    } else {
+                        1.0
+                    };
+                    let f = at.f(ls.wi) * ns.dot(ls.wi);
+                    shadow(sr.with_time(at.time), t_max, beta * f * ls.irradiance * (w / chosen));
+                };
+                for &(i, sampled) in &self.always {
+                    let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
+                    one(i, u, 1.0);
+                }
+                if let Some((i, chosen)) = self.choose_light(pick) {
+                    one(i, u, chosen);
+                }
+            }
+        }
+        if lane.bounce >= max_bounces {
+            return false;
+        }
+        let (wi, pdf) = if o.importance_sampling {
+            cosine_hemisphere(ns, sample.padded_2d())
+        } else {
+            uniform_hemisphere(ns, sample.padded_2d())
+        };
+        let cos = ns.dot(wi);
+        if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
+            return false;
+        }
+        let f = at.f(wi);
+        lane.beta *= f * (cos / pdf);
+        lane.last = Some((s.p, pdf));
+        if o.roulette == Roulette::Unbiased {
+            let Some(q) = roulette::unbiased(lane.beta, sample) else { return false };
+            lane.beta /= q;
+        }
+        if lane.beta == Color::ZERO {
+            return false;
+        }
+        lane.bounce += 1;
+        let origin = spawn_origin(scene.offset, &s, wi);
+        lane.ray = Ray::new(origin, wi).with_time(ray.time);
+        log.rays += 1;
+        true
+    }
+}
