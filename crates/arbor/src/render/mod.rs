@@ -252,15 +252,6 @@ fn trace(
     let scale = if debug.is_some() { 1.0 } else { scene.radiance_scale };
     let moving = scene.geometry.has_motion();
     let strata = Strata::new(spp);
-    // EXPERIMENT: the wavefront path tracer where it covers the scene (ARBOR_WAVEFRONT=0 turns it off).
-    let wavefront = match &integrator {
-        crate::integrator::Integrator::Path(p)
-            if p.wavefront_covers() && std::env::var("ARBOR_WAVEFRONT").as_deref() != Ok("0") =>
-        {
-            Some(p)
-        }
-        _ => None,
-    };
 
     let traced: Result<Traced> = tiles
         .par_iter()
@@ -277,7 +268,7 @@ fn trace(
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
             let per_batch = (BATCH / samples).max(1);
-            let (mut batch, mut streams, mut hits, mut radiance) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let (mut batch, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
             for group in tile.chunks(per_batch) {
                 batch.clear();
                 streams.clear();
@@ -294,17 +285,6 @@ fn trace(
                 if debug.is_none() {
                     hits.resize(batch.len(), None);
                     log.intersect_many(&scene.geometry, &batch, f32::INFINITY, &mut hits);
-                }
-                if let (None, Some(p)) = (&debug, wavefront) {
-                    p.li_batch(&batch, &hits, &mut streams, &mut log, &mut radiance);
-                    for p in 0..group.len() {
-                        let mut sum = SampleSum::default();
-                        for &c in &radiance[p * samples..(p + 1) * samples] {
-                            sum.add_sample(c);
-                        }
-                        pixels.push(sum);
-                    }
-                    continue;
                 }
                 for p in 0..group.len() {
                     let mut sum = SampleSum::default();
