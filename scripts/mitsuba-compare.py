@@ -36,9 +36,19 @@ otherwise gets, is biased) with no depth limit but its cap of 256 bounces, and M
 (rr_depth 5) with max_depth 258, the same estimand. Mitsuba's sampler is `independent` (its default)
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
 path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default (`stratified`) stratifies
-its light and bounce samples too, `--arbor-sampler independent` only the pixel position. Anything else
-(a specular lobe, textures, PLY meshes, non-uniformly scaled spheres, a lens) is refused with its reason
-and the scene skipped.
+its light and bounce samples too, `--arbor-sampler independent` only the pixel position. A flat-shaded PLY mesh
+(`<Faces plyFile=...>`) is read by Mitsuba from the same file, with the object's transformation. Anything
+else (a specular lobe, textures, smooth shading, non-uniformly scaled spheres, a lens, `AreaLight`) is
+refused with its reason and the scene skipped: Veach's `hw6/veach-ajar` is, for its textures (and its
+square `AreaLight` and Phong lobes behind them).
+
+The mesh-heavy scene: `igea-box:diffuse` or `igea-box:glass` as a SCENE argument generates (into --cache)
+the hw6 diffuse Cornell box with its spheres replaced by igea.ply (269k triangles) in white Lambertian or
+clear glass, from $ARBOR_SCENES and $ARBOR_MESHES (default ../shared/scenes, ../shared/meshes; the mesh is
+referenced, not copied):
+
+    ARBOR_SCENES=/work/shared/scenes ARBOR_MESHES=/work/shared/meshes scripts/mitsuba-compare.py \\
+        --spp 64 --threads 1,2 --variants llvm_ad_rgb --ref-spp 256 igea-box:diffuse igea-box:glass
 """
 
 import argparse
@@ -230,7 +240,7 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent",
 
     objects = root.find("Objects")
     for k, obj in enumerate([] if objects is None else list(objects)):
-        shape = shape_of(obj, verts, transforms, tmp / f"{k}.ply")
+        shape = shape_of(obj, verts, transforms, tmp / f"{k}.ply", Path(path).parent)
         shape["bsdf"] = read_material(materials[obj.findtext("Material").strip()], notes)
         if obj.tag.startswith("Light"):
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": child_floats(obj, "Radiance")}}
@@ -250,8 +260,9 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent",
     return scene, cam, max_depth, notes
 
 
-def shape_of(obj, verts, transforms, ply_path):
-    """A Mitsuba shape dict (without BSDF) for a Mesh/LightMesh/Sphere/LightSphere element."""
+def shape_of(obj, verts, transforms, ply_path, scene_dir):
+    """A Mitsuba shape dict (without BSDF) for a Mesh/LightMesh/Sphere/LightSphere element (a PLY mesh's
+    file relative to scene_dir)."""
     m = object_transform(obj, transforms)
     if obj.tag in ("Sphere", "LightSphere"):
         linear = m[:3, :3]
@@ -263,13 +274,64 @@ def shape_of(obj, verts, transforms, ply_path):
     if obj.tag not in ("Mesh", "LightMesh"):
         raise Unsupported(f"<{obj.tag}> is not translated")
     faces_node = obj.find("Faces")
-    if faces_node.get("plyFile") or obj.get("shadingMode", "flat").strip() != "flat":
-        raise Unsupported(f"{obj.tag} {obj.get('id')}: only inline flat-shaded faces are translated")
+    if obj.get("shadingMode", "flat").strip() != "flat":
+        raise Unsupported(f"{obj.tag} {obj.get('id')}: only flat-shaded meshes are translated")
+    if faces_node.get("plyFile"):
+        # Mitsuba reads the PLY itself; face normals, as Arbor shades a flat mesh.
+        return {"type": "ply", "filename": str(scene_dir / faces_node.get("plyFile").strip()), "face_normals": True,
+                "to_world": mi.ScalarTransform4f(m.tolist())}
     ids = np.array(floats(faces_node.text), dtype=int).reshape(-1, 3) + int(faces_node.get("vertexOffset", "0"))
     used, faces = np.unique(ids, return_inverse=True)
     local = (m @ np.c_[verts[used - 1], np.ones(len(used))].T).T[:, :3]
     write_ply(ply_path, local, faces.reshape(-1, 3))
     return {"type": "ply", "filename": str(ply_path), "face_normals": True}
+
+
+# ---------------------------------------------------------------------------------------------
+# The mesh-heavy scene: igea.ply (269k triangles) in the hw6 Cornell box, generated from the shared files
+
+# The materials the bust gets: a white Lambertian one, or clear glass (index 1.5, no absorption, so that
+# the translation drops nothing).
+IGEA_MATERIALS = {
+    "diffuse": ("", "<DiffuseReflectance>0.8 0.8 0.8</DiffuseReflectance>"),
+    "glass": ("dielectric", "<DiffuseReflectance>0 0 0</DiffuseReflectance><RefractionIndex>1.5</RefractionIndex>"
+                            "<AbsorptionCoefficient>0 0 0</AbsorptionCoefficient>"),
+}
+
+
+def igea_box(kind, out_dir):
+    """Writes `igea_box_<kind>.xml` into out_dir and returns its path: `cornellbox_jaroslav_path_diffuse.xml`
+    (from $ARBOR_SCENES, default ../shared/scenes) with camera 1 only and its two spheres replaced by
+    $ARBOR_MESHES/igea.ply (default ../shared/meshes), referenced by its absolute path, never copied: scaled
+    12x (1.2 high), stood up on the floor facing the camera, of material `kind` (IGEA_MATERIALS)."""
+    if kind not in IGEA_MATERIALS:
+        raise Unsupported(f"igea-box:{kind}: the material is one of {', '.join(IGEA_MATERIALS)}")
+    scenes = Path(os.environ.get("ARBOR_SCENES", "../shared/scenes"))
+    template = scenes / "ceng795-2022/hw6/pathTracing/inputs/cornellbox_jaroslav_path_diffuse.xml"
+    igea = Path(os.environ.get("ARBOR_MESHES", "../shared/meshes")) / "igea.ply"
+    for f in (template, igea):
+        if not f.is_file():
+            raise Unsupported(f"{f} is absent (set ARBOR_SCENES and ARBOR_MESHES)")
+    root = ET.parse(template).getroot()
+    cameras = root.find("Cameras")
+    for cam in cameras.findall("Camera")[1:]:
+        cameras.remove(cam)
+    objects = root.find("Objects")
+    for sphere in objects.findall("Sphere"):
+        objects.remove(sphere)
+    kind_attr, body = IGEA_MATERIALS[kind]
+    material = ET.fromstring(f'<Material id="100"{f" type={chr(34)}{kind_attr}{chr(34)}" if kind_attr else ""}>'
+                             f"<AmbientReflectance>0 0 0</AmbientReflectance>{body}<SpecularReflectance>0 0 0</SpecularReflectance>"
+                             "</Material>")
+    root.find("Materials").append(material)
+    # The bust's y axis (its height, -0.0497..0.0497) becomes the box's z; its face (+z) looks down -y.
+    root.append(ET.fromstring("<Transformations><Scaling id='1'>12 12 12</Scaling><Rotation id='1'>90 1 0 0"
+                              "</Rotation><Translation id='1'>0 0 -0.683</Translation></Transformations>"))
+    objects.append(ET.fromstring(f"<Mesh id='100'><Material>100</Material><Faces plyFile='{igea.resolve()}'/>"
+                                 "<Transformations>s1 r1 t1</Transformations></Mesh>"))
+    out = out_dir / f"igea_box_{kind}.xml"
+    ET.ElementTree(root).write(out)
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -332,14 +394,25 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
     return read_exr(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
 
+def bitmap_io(io):
+    """Runs `io` (a Mitsuba Bitmap read or write) on at least 2 Dr.Jit threads: with `dr.set_thread_count(1)`
+    Bitmap's EXR reader and writer never return (Mitsuba 3.9.1, Dr.Jit 1.5.0), which hung `--threads 1`."""
+    threads = dr.thread_count()
+    dr.set_thread_count(max(threads, 2))
+    try:
+        return io()
+    finally:
+        dr.set_thread_count(threads)
+
+
 def read_exr(path):
     mi.set_variant(REF_VARIANT)
-    return np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3]
+    return bitmap_io(lambda: np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3])
 
 
 def write_exr(path, img):
     mi.set_variant(REF_VARIANT)
-    mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)).write(str(path))
+    bitmap_io(lambda: mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32)).write(str(path)))
 
 
 def rmse(a, b):
@@ -382,6 +455,12 @@ def references(args, path, camera_id, tag, arbor_ok):
 def compare_scene(args, spec, arbor_ok):
     """Rows of the table for one SCENE[:CAMERA] argument."""
     path, _, camera_id = spec.partition(":")
+    if path == "igea-box":
+        try:
+            path, camera_id = igea_box(camera_id, args.cache), "1"
+        except Unsupported as e:
+            print(f"{spec}\n  skipped: {e}")
+            return []
     path = Path(path)
     print(f"{path.name}{':' + camera_id if camera_id else ''}", flush=True)
     mi.set_variant(REF_VARIANT)
