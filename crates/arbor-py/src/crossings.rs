@@ -23,17 +23,9 @@
 //! closest-hit query's answer when it is the first crossing). A ray that grazes an edge or a vertex
 //! without passing through the surface is one crossing there too.
 //!
-//! One more merge, for a known gap of the triangle test: its double-precision fallback is decided
-//! per triangle (when one of the triangle's edge functions is zero in single precision), so an edge
-//! it shares with a triangle that stayed in single precision can get opposite signs in the two, and
-//! a ray through a vertex can then be hit both at the vertex and just inside a neighbour (or, rarely,
-//! by none: that cannot be repaired here; docs/python.md). Two hits are also one crossing when their
-//! triangles share a vertex, their `t` differ by at most [`NEAR_T`] relative, and one of them lies
-//! within [`NEAR_EDGE`] (barycentric) of an edge.
-//!
 //! Containment: the parity of the crossings along a ray from the point, taken along the first of
-//! [`DIRECTIONS`] whose ray meets no edge and no vertex (so that every crossing is a triangle's
-//! interior, counted once); when all of them do, the majority of their parities. The mesh should be
+//! [`DIRECTIONS`] whose ray meets no edge and no vertex, nor passes within [`NEAR_EDGE`]
+//! (barycentric) of one (so that every crossing is a triangle's interior, counted once); when all of them do, the majority of their parities. The mesh should be
 //! closed; a point on the surface may go either way.
 
 use std::cell::RefCell;
@@ -142,9 +134,8 @@ fn element(mesh: &TriangleMesh, ray: &Ray, h: &RawHit) -> Element {
     }
 }
 
-/// Relative difference in `t` under which two hits near a shared vertex are one crossing.
-pub const NEAR_T: f32 = 1e-6;
-/// Barycentric distance to an edge under which a hit counts as near it.
+/// Barycentric distance to an edge under which a hit counts as near it (containment then tries
+/// another direction).
 pub const NEAR_EDGE: f32 = 1e-6;
 
 /// Whether two hits of one ray are the same crossing under the module's exact rule.
@@ -177,7 +168,7 @@ fn merge(mesh: &TriangleMesh, ray: &Ray, hits: Vec<RawHit>) -> (Vec<RawHit>, boo
     let mut group: Vec<usize> = (0..n).collect();
     for i in 0..n {
         for j in 0..i {
-            if same_crossing(elements[i], elements[j]) || near_shared_vertex(mesh, &hits[i], &hits[j]) {
+            if same_crossing(elements[i], elements[j]) {
                 let (gi, gj) = (root(&group, i), root(&group, j));
                 group[gi.max(gj)] = gi.min(gj);
             }
@@ -189,15 +180,6 @@ fn merge(mesh: &TriangleMesh, ray: &Ray, hits: Vec<RawHit>) -> (Vec<RawHit>, boo
 
 fn near_edge(h: &RawHit) -> bool {
     h.u.min(h.v).min(1.0 - h.u - h.v) <= NEAR_EDGE
-}
-
-/// The fallback gap's merge (see the module documentation).
-fn near_shared_vertex(mesh: &TriangleMesh, a: &RawHit, b: &RawHit) -> bool {
-    if (a.t - b.t).abs() > NEAR_T * a.t.abs().max(b.t.abs()) || !(near_edge(a) || near_edge(b)) {
-        return false;
-    }
-    let (p, q) = (mesh.triangle(a.prim as usize).map(bits), mesh.triangle(b.prim as usize).map(bits));
-    p.iter().any(|x| q.contains(x))
 }
 
 fn root(group: &[usize], mut i: usize) -> usize {

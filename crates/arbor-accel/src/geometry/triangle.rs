@@ -4,7 +4,8 @@
 //! Why this and not Möller-Trumbore: the edge functions are evaluated in a ray-aligned frame where a
 //! point on an edge shared by two triangles gets the same value (of opposite sign) from both, so a ray
 //! can never slip between neighbours; rays from inside a closed mesh always hit it. Edge functions that
-//! round to exactly zero are recomputed in double precision. The returned `t` is conservatively positive:
+//! round to exactly zero are recomputed in double precision, each on its own (so that an edge's value
+//! depends on its two vertices and the ray only). The returned `t` is conservatively positive:
 //! a hit closer than the floating-point error of `t` itself is rejected.
 
 use crate::math::{Ray, Vec3};
@@ -119,7 +120,7 @@ pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: 
     let mut e1 = c.x * a.y - c.y * a.x;
     let mut e2 = a.x * b.y - a.y * b.x;
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        [e0, e1, e2] = edges_f64(permute(f.dir, kx, ky, kz), [a0, b0, c0]);
+        [e0, e1, e2] = zero_edges_f64(permute(f.dir, kx, ky, kz), [a0, b0, c0], [e0, e1, e2]);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
@@ -168,19 +169,37 @@ pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: 
     Some(TriHit { t, b1: e1 * inv_det, b2: e2 * inv_det })
 }
 
-/// The edge functions in double precision, sheared in double too, for when a single-precision one is
-/// exactly zero (Woop et al.'s fallback). Shearing again matters at tiny scales: a single-precision
-/// `sx * a.z` can underflow to zero and put a vertex exactly on a ray that passes it at 1e-79, which
-/// no box test of the true ray would reach (found by the conformance suite). A nonzero double value
-/// that underflows in single precision keeps its sign as the smallest subnormal. The shared edge of
-/// two triangles is computed from the same two vertices either way, so watertightness holds.
+/// The edge functions `e`, each one that is exactly zero in single precision recomputed in double
+/// precision, sheared in double too (Woop et al.'s fallback, decided edge by edge).
+///
+/// Why edge by edge: an edge's value must depend only on its two corners and the ray, so that the edge
+/// shared by two triangles gets the same magnitude with opposite signs from both, whatever their other
+/// edges. A nonzero single value has the exact sign of the edge function of the corners as sheared in
+/// single precision (the products round monotonically, and the difference of two floats has the exact
+/// sign); a zero means the ray meets that edge's line there, or its two products round alike, and the
+/// double value only picks a side of that line: the hit goes to one of the two triangles sharing the
+/// edge, or to both when it is zero again. Recomputing all three edges of a triangle when one is zero,
+/// as this test did, mixed the two shears: they differ by as much as a ray aimed at a vertex misses it
+/// by, so the edge shared with a neighbour that stayed in single precision could get the same sign from
+/// both, and the ray slipped through the vertex's fan (about 1% of oblique rays aimed at the vertices of
+/// an integer grid; `geometry/watertight_tests.rs`). pbrt-v4 recomputes from the single-precision
+/// sheared corners instead, which is consistent but not the fix for the case below.
+///
+/// Shearing again matters at tiny scales: a single-precision `sx * a.z` can underflow to zero and put a
+/// vertex exactly on a ray that passes it at 1e-79, which no box test of the true ray would reach (found
+/// by the conformance suite). A nonzero double value that underflows in single precision keeps its sign
+/// as the smallest subnormal.
 #[cold]
-fn edges_f64(d: Vec3, [a, b, c]: [Vec3; 3]) -> [f32; 3] {
+fn zero_edges_f64(d: Vec3, [a, b, c]: [Vec3; 3], e: [f32; 3]) -> [f32; 3] {
     let sz = 1.0 / d.z as f64;
     let (sx, sy) = (-d.x as f64 * sz, -d.y as f64 * sz);
     let shear = |p: Vec3| (p.x as f64 + sx * p.z as f64, p.y as f64 + sy * p.z as f64);
-    let ((ax, ay), (bx, by), (cx, cy)) = (shear(a), shear(b), shear(c));
-    let single = |e: f64| {
+    let [a, b, c] = [shear(a), shear(b), shear(c)];
+    let edge = |e: f32, (px, py): (f64, f64), (qx, qy): (f64, f64)| {
+        if e != 0.0 {
+            return e;
+        }
+        let e = px * qy - py * qx;
         let f = e as f32;
         if f == 0.0 && e != 0.0 {
             f32::from_bits(1).copysign(e.signum() as f32)
@@ -188,7 +207,7 @@ fn edges_f64(d: Vec3, [a, b, c]: [Vec3; 3]) -> [f32; 3] {
             f
         }
     };
-    [single(bx * cy - by * cx), single(cx * ay - cy * ax), single(ax * by - ay * bx)]
+    [edge(e[0], b, c), edge(e[1], c, a), edge(e[2], a, b)]
 }
 
 #[cfg(test)]
