@@ -3,7 +3,7 @@
 //! DNS rebinding), and the token is there, as `?token=` or an `X-Arbor-Token` header (a local user or a
 //! page that does not know it can do nothing). Bodies are JSON of at most [`MAX_BODY`] bytes; a bad
 //! request is a 4xx with `{"error": "..."}`, never a panic; a body that does not arrive whole within
-//! [`crate::listener::HEADER_TIMEOUT`] of its headers is a 408, so a client that sends a body slowly or not
+//! the header deadline (`listener::HEADER_TIMEOUT`, 10 s) of its headers is a 408, so a client that sends a body slowly or not
 //! at all cannot hold a connection slot.  Heavy requests (inspecting a pixel, the
 //! side-by-side heatmaps) take one of [`HEAVY`] slots or get 503; event streams one of [`STREAMS`].
 

@@ -3,7 +3,7 @@
 //! brute force returns, and the refusal for primitives that cannot answer.
 //!
 //! The answer, for query point `p` and bound `max_distance`: among the primitives whose closest point
-//! `q` ([`Primitives::closest_point`], in `f64`) has a squared distance `d² = |q - p|²` that is a number
+//! `q` ([`crate::accel::Primitives::closest_point`], in `f64`) has a squared distance `d² = |q - p|²` that is a number
 //! and at most `max_distance²`, the one with the smallest `d²`, ties to the lowest primitive index.
 //! `d²` is computed here, by one function ([`dist2`]), whichever structure meets the primitive, so a
 //! tie is decided on the same numbers everywhere; the primitive's point comes from one function too
