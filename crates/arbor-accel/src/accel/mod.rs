@@ -27,6 +27,8 @@ pub mod octree;
 mod params;
 mod stats;
 mod structure;
+#[cfg(test)]
+mod watertight_tests;
 
 use std::fmt;
 use std::str::FromStr;

@@ -10,8 +10,6 @@ mod triangle;
 mod triangle4;
 mod triangle_box;
 mod triangle_clip;
-#[cfg(test)]
-mod watertight_tests;
 
 pub use closest_point::{closest_point_on_triangle, closest_point_on_triangle_f64};
 pub use mesh::{MeshError, MeshReport, TriangleMesh};

@@ -182,7 +182,7 @@ pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: 
 /// as this test did, mixed the two shears: they differ by as much as a ray aimed at a vertex misses it
 /// by, so the edge shared with a neighbour that stayed in single precision could get the same sign from
 /// both, and the ray slipped through the vertex's fan (about 1% of oblique rays aimed at the vertices of
-/// an integer grid; `geometry/watertight_tests.rs`). pbrt-v4 recomputes from the single-precision
+/// an integer grid; `accel/watertight_tests.rs`). pbrt-v4 recomputes from the single-precision
 /// sheared corners instead, which is consistent but not the fix for the case below.
 ///
 /// Shearing again matters at tiny scales: a single-precision `sx * a.z` can underflow to zero and put a

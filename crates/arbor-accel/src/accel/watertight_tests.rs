@@ -10,10 +10,8 @@
 //! These failed before each edge function's double-precision fallback was decided edge by edge: about
 //! 1% of the grid's vertex-aimed rays hit nothing (`geometry/triangle.rs`).
 
-use super::triangle::{intersect_triangle_in, RayFrame, TriHit};
-use super::triangle4::{intersect_triangles4, Tri4};
-use super::TriangleMesh;
-use crate::accel::{build, AccelKind};
+use super::{build, AccelKind};
+use crate::geometry::{intersect_triangle_in, intersect_triangles4, RayFrame, Tri4, TriHit, TriangleMesh};
 use crate::math::{Ray, Vec3};
 use crate::test_rng::Rng;
 
