@@ -378,7 +378,8 @@ impl<P: Primitives + ?Sized> Accel<P> for KdTree {
     }
 
     fn closest_point(&self, prims: &P, p: DVec3, max_dist2: f64) -> Option<Nearest> {
-        nearest::closest_point(self, prims, p, max_dist2)
+        let slack = crate::accel::nearest::slack(&self.bounds);
+        crate::accel::nearest::query(p, max_dist2, slack, |best| nearest::walk(self, prims, best))
     }
 
     fn stats(&self) -> AccelStats {

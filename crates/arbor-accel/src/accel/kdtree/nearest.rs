@@ -8,23 +8,12 @@
 //! not change. Cost: at most one push per level, so a stack of [`MAX_DEPTH`] entries suffices.
 
 use super::{split_box, KdTree, MAX_DEPTH};
-use crate::accel::nearest::{self, aabb_dist2, NearestSoFar};
-use crate::accel::{Nearest, Primitives};
-use crate::math::{Aabb, DVec3};
-
-/// The primitive nearest to `p` within squared distance `max_dist2` (`accel/nearest.rs`).
-pub(super) fn closest_point<P: Primitives + ?Sized>(
-    tree: &KdTree,
-    prims: &P,
-    p: DVec3,
-    max_dist2: f64,
-) -> Option<Nearest> {
-    let slack = nearest::slack(&tree.bounds);
-    nearest::query(p, max_dist2, slack, |best| walk(tree, prims, best))
-}
+use crate::accel::nearest::{aabb_dist2, NearestSoFar};
+use crate::accel::Primitives;
+use crate::math::Aabb;
 
 /// Offers `best` the primitives of the leaves within its bound, nearest leaves first.
-fn walk<P: Primitives + ?Sized>(tree: &KdTree, prims: &P, best: &mut NearestSoFar) {
+pub(super) fn walk<P: Primitives + ?Sized>(tree: &KdTree, prims: &P, best: &mut NearestSoFar) {
     if tree.nodes.is_empty() {
         return;
     }

@@ -10,26 +10,15 @@
 //! Cost: at most seven pushes per level, so `1 + 7 * MAX_DEPTH` entries suffice.
 
 use super::{child_box, split_point, Octree, MAX_DEPTH};
-use crate::accel::nearest::{self, aabb_dist2, NearestSoFar};
-use crate::accel::{Nearest, Primitives};
-use crate::math::{Aabb, DVec3};
+use crate::accel::nearest::{aabb_dist2, NearestSoFar};
+use crate::accel::Primitives;
+use crate::math::Aabb;
 
 /// Deepest stack: each inner level pops one cell and pushes at most seven besides the one it goes on with.
 const STACK: usize = 1 + 7 * MAX_DEPTH;
 
-/// The primitive nearest to `p` within squared distance `max_dist2` (`accel/nearest.rs`).
-pub(super) fn closest_point<P: Primitives + ?Sized>(
-    tree: &Octree,
-    prims: &P,
-    p: DVec3,
-    max_dist2: f64,
-) -> Option<Nearest> {
-    let slack = nearest::slack(&tree.bounds);
-    nearest::query(p, max_dist2, slack, |best| walk(tree, prims, best))
-}
-
 /// Offers `best` the primitives of the leaves within its bound, nearest cells first.
-fn walk<P: Primitives + ?Sized>(tree: &Octree, prims: &P, best: &mut NearestSoFar) {
+pub(super) fn walk<P: Primitives + ?Sized>(tree: &Octree, prims: &P, best: &mut NearestSoFar) {
     let (nodes, refs) = (&tree.nodes, &tree.refs);
     if nodes.is_empty() {
         return;
