@@ -181,10 +181,9 @@ pub fn surface_point(corners: [Vec3; 3], u: f32, v: f32) -> [f32; 3] {
 }
 
 /// The first `len` values of `v`'s room (`len` is 0 or what it was made with) in pieces of
-/// `width * CHUNK` values, one per chunk of `chunks`: empty pieces for a field not asked for.
-fn pieces<T>(v: &mut Vec<T>, len: usize, width: usize, chunks: usize) -> impl Iterator<Item = &mut [MaybeUninit<T>]> {
-    let mut it = v.spare_capacity_mut()[..len].chunks_mut(width * CHUNK);
-    (0..chunks).map(move |_| it.next().unwrap_or_default())
+/// `width * CHUNK` values, one per chunk (none for a field not asked for).
+fn pieces<T>(v: &mut Vec<T>, len: usize, width: usize) -> impl Iterator<Item = &mut [MaybeUninit<T>]> {
+    v.spare_capacity_mut()[..len].chunks_mut(width * CHUNK)
 }
 
 /// One chunk's rows of every output, to be written.
@@ -223,12 +222,12 @@ pub fn closest(s: &Structure, rays: RaySet<'_>, fields: Fields) -> Closest {
     let chunks = n.div_ceil(CHUNK);
     // The pieces borrow `out` until every row is written.
     {
-        let mut t = pieces(&mut out.t, len(fields.t, 1), 1, chunks);
-        let mut triangle = pieces(&mut out.triangle, len(fields.triangle, 1), 1, chunks);
-        let mut u = pieces(&mut out.u, len(fields.uv, 1), 1, chunks);
-        let mut v = pieces(&mut out.v, len(fields.uv, 1), 1, chunks);
-        let mut normal = pieces(&mut out.normal, len(fields.normal, 3), 3, chunks);
-        let mut point = pieces(&mut out.point, len(fields.point, 3), 3, chunks);
+        let mut t = pieces(&mut out.t, len(fields.t, 1), 1);
+        let mut triangle = pieces(&mut out.triangle, len(fields.triangle, 1), 1);
+        let mut u = pieces(&mut out.u, len(fields.uv, 1), 1);
+        let mut v = pieces(&mut out.v, len(fields.uv, 1), 1);
+        let mut normal = pieces(&mut out.normal, len(fields.normal, 3), 3);
+        let mut point = pieces(&mut out.point, len(fields.point, 3), 3);
         let rows: Vec<OutRows<'_>> = (0..chunks)
             .map(|_| OutRows {
                 t: t.next().unwrap_or_default(),
@@ -392,8 +391,7 @@ pub fn closest_points(
     points: Rows<'_>,
     max_distance: f64,
 ) -> Result<ClosestPoints, ClosestPointUnsupported> {
-    // Whether the structure answers at all, asked once (an empty batch): every chunk then can.
-    s.closest_points_many(&[], max_distance, &mut [])?;
+    s.check_closest_point()?;
     let n = points.len();
     let mut out = ClosestPoints {
         point: vec![f64::NAN; 3 * n],
@@ -412,7 +410,7 @@ pub fn closest_points(
         .for_each(|(c, ((((d, tri), u), v), pt))| {
             let batch: Vec<_> = (c * CHUNK..c * CHUNK + d.len()).map(|i| points.get_f64(i)).collect();
             let mut found: Vec<Option<Nearest>> = vec![None; batch.len()];
-            // Answers, as the empty batch above did.
+            // Answers: checked above.
             let _ = s.closest_points_many(&batch, max_distance, &mut found);
             for (j, f) in found.iter().enumerate() {
                 let Some(f) = f else { continue };

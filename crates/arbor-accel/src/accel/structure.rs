@@ -171,7 +171,9 @@ impl<P: Primitives + ?Sized + Send + 'static> Structure<P> {
         Ok(())
     }
 
-    fn check_closest_point(&self) -> Result<(), ClosestPointUnsupported> {
+    /// Whether closest-point queries are answered (`Ok`) or refused with the error every one of them
+    /// would return, asked once before a batch split across threads.
+    pub fn check_closest_point(&self) -> Result<(), ClosestPointUnsupported> {
         if self.prims.has_closest_point() {
             Ok(())
         } else {
