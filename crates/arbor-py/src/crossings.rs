@@ -24,9 +24,9 @@
 //! without passing through the surface is one crossing there too.
 //!
 //! Containment: the parity of the crossings along a ray from the point, taken along the first of
-//! [`DIRECTIONS`] whose ray meets no edge and no vertex, nor passes within [`NEAR_EDGE`]
-//! (barycentric) of one (so that every crossing is a triangle's interior, counted once); when all of them do, the majority of their parities. The mesh should be
-//! closed; a point on the surface may go either way.
+//! [`DIRECTIONS`] whose ray meets no edge and no vertex, nor passes within [`NEAR_EDGE`] (barycentric)
+//! of one (so that every crossing is a triangle's interior, counted once); when all of them do, the
+//! majority of their parities. The mesh should be closed; a point on the surface may go either way.
 
 use std::cell::RefCell;
 use std::sync::Arc;

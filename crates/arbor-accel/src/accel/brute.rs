@@ -1,5 +1,5 @@
-//! Brute force: every ray tests every primitive (and every closest-point query weighs every primitive). The reference every other structure is checked against,
-//! and the baseline of `arbor bench`'s speedups.
+//! Brute force: every ray tests every primitive, and every closest-point query weighs every primitive.
+//! The reference every other structure is checked against, and the baseline of `arbor bench`'s speedups.
 
 use std::time::Instant;
 

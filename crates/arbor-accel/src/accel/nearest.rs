@@ -59,9 +59,9 @@ pub struct Nearest {
     pub point: DVec3,
     /// The squared distance between the two.
     pub dist2: f64,
-    /// Surface parameters of the point, see [`PrimPoint`].
+    /// First surface parameter of the point, see [`PrimPoint`].
     pub u: f64,
-    /// Surface parameters of the point, see [`PrimPoint`].
+    /// Second surface parameter of the point, see [`PrimPoint`].
     pub v: f64,
 }
 

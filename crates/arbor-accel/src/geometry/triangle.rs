@@ -178,8 +178,8 @@ pub fn intersect_triangle_in(f: &RayFrame, p0: Vec3, p1: Vec3, p2: Vec3, t_max: 
 /// single precision (the products round monotonically, and the difference of two floats has the exact
 /// sign); a zero means the ray meets that edge's line there, or its two products round alike, and the
 /// double value only picks a side of that line: the hit goes to one of the two triangles sharing the
-/// edge, or to both when it is zero again. Recomputing all three edges of a triangle when one is zero,
-/// as this test did, mixed the two shears: they differ by as much as a ray aimed at a vertex misses it
+/// edge, or to both when it is zero again. Recomputing all three edges of a triangle when one is zero
+/// would mix the two shears: they differ by as much as a ray aimed at a vertex misses it
 /// by, so the edge shared with a neighbour that stayed in single precision could get the same sign from
 /// both, and the ray slipped through the vertex's fan (about 1% of oblique rays aimed at the vertices of
 /// an integer grid; `accel/watertight_tests.rs`). pbrt-v4 recomputes from the single-precision
