@@ -242,10 +242,7 @@ def closest_points(args, name, v, f, m, tm, threads, rs):
         import trimesh
 
         slow = check[: min(args.slow_points, len(check))]
-        t0, c0 = time.perf_counter(), time.process_time()
-        _, dist, _ = trimesh.proximity.closest_point(tm, points[slow])
-        secs = time.perf_counter() - t0
-        CPU.append((time.process_time() - c0) / secs)
+        secs, (_, dist, _) = timed(lambda: trimesh.proximity.closest_point(tm, points[slow]), 1)
         for th in threads:
             record("trimesh proximity (subset)", th, secs, len(slow), dist)
     except ImportError:
