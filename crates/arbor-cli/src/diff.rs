@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use arbor::film::Film;
 use arbor::image_io::levels::{BlockLevels, DisplayCurve};
 use arbor::image_io::metrics::{compare_block_levels, compare_blocks_rgb8, compare_rgb8, BlockComparison, Comparison};
-use arbor::image_io::noisy::{compare_noisy, compare_noisy_rgb8};
+use arbor::image_io::noisy::{compare_noisy, compare_noisy_rgb8, compare_noisy_tonemapped, NoisyComparison};
 use arbor::image_io::{is_hdr_path, read, read_image_within, ImageLimits};
+use arbor::tonemap::Tonemap;
 use clap::Args;
 
 use crate::Failure;
@@ -44,6 +45,12 @@ pub struct DiffArgs {
     /// difference within 2 levels. --threshold and --max-off do not apply.
     #[arg(long, value_name = "IMAGE_OTHER_SEED")]
     pub noise: Option<PathBuf>,
+    /// With --noise, for an 8-bit reference written through the course's tone curve (a camera's
+    /// `Tonemap`: the photographic operator's key, burn-out percent, saturation and gamma) and IMAGE and
+    /// IMAGE_OTHER_SEED as radiance (.exr, .hdr): both are shown through that curve under one exposure,
+    /// the one that fits the reference best, since the reference's own came from its renderer's noise.
+    #[arg(long, value_name = "KEY,BURN,SATURATION,GAMMA", value_parser = parse_tonemap, requires = "noise")]
+    pub tonemap: Option<Tonemap>,
     /// Lift the limit on the pixels of each image (2^28, the most `arbor render` writes by default).
     #[arg(long)]
     pub no_limits: bool,
@@ -55,6 +62,26 @@ fn parse_percent(s: &str) -> Result<f64, String> {
         Ok(p) if (0.0..=100.0).contains(&p) => Ok(p),
         Ok(_) => Err(format!("'{s}' is not a percentage from 0 to 100")),
         Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// Parses `--tonemap KEY,BURN,SATURATION,GAMMA` into the photographic operator, in the scene's units.
+fn parse_tonemap(s: &str) -> Result<Tonemap, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not four numbers KEY,BURN,SATURATION,GAMMA (the course's: 0.18,1,1,2.2)"))?;
+    match v[..] {
+        [key, burn, saturation, gamma]
+            if key > 0.0 && (0.0..=100.0).contains(&burn) && saturation >= 0.0 && gamma > 0.0 && v.iter().all(|x| x.is_finite()) =>
+        {
+            Ok(Tonemap { key, burn_percent: burn, saturation, gamma, ..Tonemap::PREVIEW })
+        }
+        [_, _, _, _] => Err(format!(
+            "'{s}': the key and gamma must be positive, the burn-out a percentage from 0 to 100, the saturation at least 0"
+        )),
+        _ => Err(format!("'{s}' is not four numbers KEY,BURN,SATURATION,GAMMA (the course's: 0.18,1,1,2.2)")),
     }
 }
 
@@ -180,10 +207,49 @@ impl Images {
     }
 }
 
+/// `--noise` with `--tonemap`: the 8-bit reference against two seeds' radiance under the fitted exposure.
+fn tonemapped(
+    args: &DiffArgs,
+    tonemap: &Tonemap,
+    other: &Path,
+    limits: &ImageLimits,
+) -> Result<NoisyComparison, Failure> {
+    let (w, h, reference) = match Read::of(&args.reference, limits)? {
+        Read::Rgb8(w, h, px) => (w, h, px),
+        Read::Hdr(_) => {
+            return Err(Failure::Usage(format!(
+                "--tonemap is for an 8-bit reference, and {} is an HDR one: leave --tonemap out",
+                args.reference.display()
+            )))
+        }
+    };
+    let mut films = Vec::new();
+    for path in [args.image.as_path(), other] {
+        let Read::Hdr(film) = Read::of(path, limits)? else {
+            return Err(Failure::Usage(format!(
+                "{} is an 8-bit image: with --tonemap the two renders are radiance (.exr, .hdr)",
+                path.display()
+            )));
+        };
+        if (film.width, film.height) != (w, h) {
+            let msg = format!("{} is {}x{} but the reference is {w}x{h}", path.display(), film.width, film.height);
+            return Err(arbor::Error::Invalid(msg).into());
+        }
+        films.push(film);
+    }
+    say!("8-bit reference: the renders' radiance through the tone curve, under the exposure that fits it best");
+    Ok(compare_noisy_tonemapped(&reference, tonemap, &films[0], &films[1], args.block.unwrap_or(NOISE_BLOCK)))
+}
+
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
     let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
     let limits = crate::render::limits(args.no_limits).rendered();
+    if let (Some(tonemap), Some(other)) = (&args.tonemap, &args.noise) {
+        let c = tonemapped(&args, tonemap, other, &limits)?;
+        say!("{}", c.summary());
+        return if c.passes() { Ok(()) } else { Err(Failure::TooDifferent) };
+    }
     let images = read_all(&args.reference, &paths, &limits)?;
     if matches!(images, Images::Hdr { .. }) {
         say!(

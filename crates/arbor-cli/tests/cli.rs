@@ -349,6 +349,48 @@ fn cli_diff_hdr_images_in_the_reference_curve() {
 }
 
 #[test]
+fn cli_diff_noise_tonemap_shows_radiance_under_the_exposure_an_8bit_reference_implies() {
+    use arbor::tonemap::{Exposure, Tonemap};
+    let tmp = tempfile::tempdir().unwrap();
+    // A ramp of radiance, and the course's curve of it at 1.3 times its own exposure as the reference.
+    let ramp = |x: u32, y: u32| 0.05 + (x + 32 * y) as f32 / 256.0;
+    exr(tmp.path(), "seed1.exr", 32, 32, ramp);
+    exr(tmp.path(), "seed2.exr", 32, 32, ramp);
+    exr(tmp.path(), "moved.exr", 32, 32, |x, y| ramp(x, y) * if x < 16 { 1.0 } else { 1.5 });
+    let tm = Tonemap { key: 0.18, burn_percent: 1.0, saturation: 1.0, gamma: 2.2, ..Tonemap::PREVIEW };
+    let film = arbor::image_io::read_image(&tmp.path().join("seed1.exr")).unwrap();
+    let own = tm.exposure(&film);
+    let shown = tm.apply_exposure(&film, Exposure { scale: own.scale * 1.3, white: own.white.map(|w| w * 1.3) });
+    let px = shown.to_rgb8();
+    ppm(tmp.path(), "ref.ppm", 32, 32, |x, y| {
+        let i = 3 * (32 * y + x) as usize;
+        [px[i], px[i + 1], px[i + 2]]
+    });
+    let args = |image: &'static str, other: &'static str| {
+        ["diff", "ref.ppm", image, "--noise", other, "--tonemap", "0.18,1,1,2.2"]
+    };
+    let o = arbor(&args("seed1.exr", "seed2.exr"), tmp.path());
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("16x16 blocks at 1.3") && stdout(&o).ends_with(": OK\n"), "{}", stdout(&o));
+    // Light moved between the halves is no exposure: no factor brings it back.
+    let o = arbor(&args("moved.exr", "moved.exr"), tmp.path());
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    // The wrong kinds of image, and a curve that is not one.
+    let o = arbor(&["diff", "seed1.exr", "seed1.exr", "--noise", "seed2.exr", "--tonemap", "0.18,1,1,2.2"], tmp.path());
+    let want = "error: --tonemap is for an 8-bit reference, and seed1.exr is an HDR one: leave --tonemap out\n";
+    assert_eq!((o.status.code(), stderr(&o)), (Some(2), want.to_string()));
+    let o = arbor(&["diff", "ref.ppm", "ref.ppm", "--noise", "seed2.exr", "--tonemap", "0.18,1,1,2.2"], tmp.path());
+    let want = "error: ref.ppm is an 8-bit image: with --tonemap the two renders are radiance (.exr, .hdr)\n";
+    assert_eq!((o.status.code(), stderr(&o)), (Some(2), want.to_string()));
+    let o = arbor(&["diff", "ref.ppm", "seed1.exr", "--noise", "seed2.exr", "--tonemap", "0.18,1,1,0"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("the key and gamma must be positive"), "{}", stderr(&o));
+    let o = arbor(&["diff", "ref.ppm", "seed1.exr", "--tonemap", "0.18,1,1,2.2"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--noise"), "{}", stderr(&o));
+}
+
+#[test]
 fn cli_diff_block_zero_is_a_usage_error() {
     let tmp = tempfile::tempdir().unwrap();
     ppm(tmp.path(), "ref.ppm", 2, 2, |_, _| [100; 3]);

@@ -4,11 +4,14 @@
 //! on 16x16 block means in display levels the seed-1 render must be as close to the reference as to the
 //! seed-2 render, plus 1 level, with every channel's mean signed difference within 2 levels. Where the
 //! official EXR is there, the blocks are means of radiance put through one curve the reference EXR fixes
-//! ([`arbor::image_io::levels`]); the 2019 references are PNGs only, compared PNG to PNG.
+//! ([`arbor::image_io::levels`]); the 2019 references are PNGs only, compared PNG to PNG, the renders
+//! shown through their camera's tone curve under the one exposure that fits the reference
+//! ([`compare_noisy_tonemapped`]): the official PNG's exposure came from its renderer's own noisy
+//! log-average, as a render's would from its own (docs/reference-results.md measures both).
 //!
-//! A PNG's tone curve takes its exposure (log-average and burn-out white) from the whole image, so a
-//! PNG-only reference is always compared with whole-frame renders: a window tone-mapped on its own is
-//! exposed differently (it put the 2019 references 23 to 61 levels off).
+//! A PNG's tone curve takes its burn-out white from the whole image, so a PNG-only reference is always
+//! compared with whole-frame renders: a window tone-mapped on its own is exposed differently (it put
+//! the 2019 references 23 to 61 levels off).
 //!
 //! The ignored `reference_path_tracing` takes every camera at its own samples N over the whole frame,
 //! but for cameras of more than [`WHOLE_FRAME_SAMPLES`] samples (Veach's scene, 2500 per pixel), which it
@@ -27,7 +30,7 @@ use std::time::Instant;
 
 use arbor::accel::AccelConfig;
 use arbor::film::Film;
-use arbor::image_io::noisy::{compare_noisy_hdr, compare_noisy_rgb8, NoisyComparison};
+use arbor::image_io::noisy::{compare_noisy_hdr, compare_noisy_rgb8, compare_noisy_tonemapped, NoisyComparison};
 use arbor::image_io::read_image;
 use arbor::render::{render, RenderOptions};
 use arbor::renderer::{PathOptions, Renderer, Roulette};
@@ -127,14 +130,16 @@ fn judge(
         let radiance = |f: &Film| Film { pixels: f.pixels.iter().map(|&c| c / scene.radiance_scale).collect(), ..*f };
         return compare_noisy_hdr(&window(&official, crop), &radiance(films[0]), &radiance(films[1]), BLOCK);
     }
-    let rgb8 = |f: &Film| match scene.cameras[camera].tonemap {
-        Some(t) => t.apply(f).to_rgb8(),
-        None => f.to_rgb8(),
-    };
     // An 8-bit image read as a film holds its levels over 255, which `to_rgb8` gives back exactly.
     let official = window(&read_image(reference).unwrap_or_else(|e| panic!("{e}")), crop).to_rgb8();
-    let (cw, ch) = (crop.2 - crop.0, crop.3 - crop.1);
-    compare_noisy_rgb8(&official, &rgb8(films[0]), &rgb8(films[1]), cw, ch, BLOCK)
+    match scene.cameras[camera].tonemap {
+        // The reference's exposure came from its own noise: both seeds under the one that fits it.
+        Some(t) => compare_noisy_tonemapped(&official, &t, films[0], films[1], BLOCK),
+        None => {
+            let (cw, ch) = (crop.2 - crop.0, crop.3 - crop.1);
+            compare_noisy_rgb8(&official, &films[0].to_rgb8(), &films[1].to_rgb8(), cw, ch, BLOCK)
+        }
+    }
 }
 
 /// Which part of each camera's frame a run renders.
@@ -151,7 +156,7 @@ enum Scope {
 /// Renders and judges every case over `scope` (a PNG-only reference: always the whole frame).
 fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, scope: Scope) -> Vec<String> {
     let mut failures = Vec::new();
-    println!("## {title}\n\n| scene | camera | image | N | window | render vs reference | seed vs seed | bias R G B | result | render s |\n|---|---|---|---|---|---|---|---|---|---|");
+    println!("## {title}\n\n| scene | camera | image | N | window | exposure | render vs reference | seed vs seed | bias R G B | result | render s |\n|---|---|---|---|---|---|---|---|---|---|---|");
     let mut current: Option<(PathBuf, Scene)> = None;
     for case in cases {
         if current.as_ref().is_none_or(|(p, _)| *p != case.scene) {
@@ -197,8 +202,10 @@ fn run(title: &str, cases: Vec<Case>, skipped: Vec<String>, scope: Scope) -> Vec
             (false, false) => "FAIL",
         };
         println!(
-            "| {name} | {} | {image} | {n} | {cw}x{ch} | {:.2} | {:.2} | {:+.2} {:+.2} {:+.2} | {result} | {secs:.1} |",
-            cam.id, c.mad, c.noise, c.bias[0], c.bias[1], c.bias[2],
+            "| {name} | {} | {image} | {n} | {cw}x{ch} | {} | {:.2} | {:.2} | {:+.2} {:+.2} {:+.2} | {result} | {secs:.1} |",
+            cam.id,
+            c.exposure.map_or("reference's".to_string(), |k| format!("{k:.3} x own")),
+            c.mad, c.noise, c.bias[0], c.bias[1], c.bias[2],
         );
         if !c.passes() && !known {
             failures.push(format!("{name} camera {} -> {image}: {}", cam.id, c.summary()));
