@@ -47,7 +47,12 @@ fn describe_path_tracer(o: PathOptions) -> String {
         }
         Roulette::Unbiased => "Arbor's unbiased Russian roulette",
     };
-    format!("{}; {roulette}", words.join(", "))
+    let glass = if o.split_refraction {
+        "; both lobes of refractive surfaces followed, as the course's renderer does"
+    } else {
+        ""
+    };
+    format!("{}; {roulette}{glass}", words.join(", "))
 }
 
 /// Runs `arbor info`.

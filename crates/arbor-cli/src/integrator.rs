@@ -15,7 +15,8 @@ pub struct IntegratorArgs {
     pub integrator: Option<IntegratorArg>,
     /// The path tracer's options, overriding the scene's RendererParams: a comma-separated list of
     /// importance, next-event, roulette (Arbor's unbiased Russian roulette) and mis (mis turns on the
-    /// first two), or none for the plain path tracer. Implies --integrator path.
+    /// first two), or none for the plain path tracer. Implies --integrator path. A METU camera's own options
+    /// follow both lobes of refractive surfaces, as the course's renderer does; these pick one at random.
     #[arg(long, value_enum, value_delimiter = ',', value_name = "OPTIONS")]
     pub path_options: Option<Vec<PathOption>>,
     /// Which Russian roulette the path-traced cameras that have one use. Without it, a camera whose scene
@@ -167,7 +168,13 @@ mod tests {
         assert_eq!(args(Some(IntegratorArg::Path), None).renderer(Renderer::Whitted), Ok(Some(default)));
         // MIS turns on both samplings; `none` is the plain path tracer, over the scene's options.
         let mis = args(None, Some(vec![PathOption::Mis, PathOption::Roulette])).renderer(scene);
-        let want = PathOptions { importance_sampling: true, next_event: true, roulette: Roulette::Unbiased, mis: true };
+        let want = PathOptions {
+            importance_sampling: true,
+            next_event: true,
+            roulette: Roulette::Unbiased,
+            mis: true,
+            ..PathOptions::default()
+        };
         assert_eq!(mis, Ok(Some(Renderer::PathTracing(want))));
         let plain = args(Some(IntegratorArg::Path), Some(vec![PathOption::None])).renderer(scene);
         assert_eq!(plain, Ok(Some(Renderer::PathTracing(PathOptions::default()))));

@@ -412,11 +412,16 @@ fn cli_info_describes_the_scene() {
     let camera = "<ImageName>tiny.png</ImageName><Renderer>PathTracing</Renderer>";
     let with = |params: &str| TINY.replace("<ImageName>tiny.IMAGE_EXT</ImageName>", &format!("{camera}{params}"));
     for (params, line) in [
-        ("", "  renderer path tracing; paths end at MaxRecursionDepth\n"),
+        (
+            "",
+            "  renderer path tracing; paths end at MaxRecursionDepth; both lobes of refractive surfaces followed, \
+             as the course's renderer does\n",
+        ),
         (
             "<RendererParams>NextEventEstimation RussianRoulette</RendererParams>",
             "  renderer path tracing, next event estimation; the course's Russian roulette (biased: brighter than \
-             the converged answer; --roulette unbiased for Arbor's)\n",
+             the converged answer; --roulette unbiased for Arbor's); both lobes of refractive surfaces followed, \
+             as the course's renderer does\n",
         ),
     ] {
         let b = write(tmp.path(), "b.xml", &with(params));

@@ -26,13 +26,22 @@ pub struct PathOptions {
     /// Light samples and bounce directions both count where they meet an emitter, weighted by the power
     /// heuristic (Veach 1997), instead of discarding the bounce's (`MIS`; implies the two samplings).
     pub mis: bool,
+    /// Paths follow every lobe of a refractive surface, and its BRDF bounce too, within
+    /// `MaxRecursionDepth`, rather than one lobe picked at random: what the course's renderer does, so
+    /// what a METU path-traced camera gets ([`crate::integrator`]'s `split` module).
+    pub split_refraction: bool,
 }
 
 impl PathOptions {
     /// What `--integrator path` uses for a camera that names no renderer: importance sampling, next
     /// event estimation and multiple importance sampling, paths ended at the recursion limit.
-    pub const DEFAULT: PathOptions =
-        PathOptions { importance_sampling: true, next_event: true, roulette: Roulette::Off, mis: true };
+    pub const DEFAULT: PathOptions = PathOptions {
+        importance_sampling: true,
+        next_event: true,
+        roulette: Roulette::Off,
+        mis: true,
+        split_refraction: false,
+    };
 
     /// These options with what they imply: MIS weighs light samples against importance-sampled bounces,
     /// so it turns both on.

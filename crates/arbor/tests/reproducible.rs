@@ -177,9 +177,16 @@ fn reproducible_example_for_thread_counts_and_crops() {
 
 #[test]
 fn reproducible_course_roulette_for_thread_counts_and_crops() {
-    // The course's roulette draws a number only where a survival is uncertain: still one stream per sample.
+    // The course's roulette draws a number only where a survival is uncertain, and the course's split at
+    // the glass traces its branches in a fixed order: still one stream per sample.
     let scene = example();
-    let options = PathOptions { importance_sampling: true, next_event: true, roulette: Roulette::Course, mis: false };
+    let options = PathOptions {
+        importance_sampling: true,
+        next_event: true,
+        roulette: Roulette::Course,
+        mis: false,
+        split_refraction: true,
+    };
     let opts = RenderOptions { renderer: Some(Renderer::PathTracing(options)), spp: Some(4), ..Default::default() };
     let full = render_on(2, &scene, 0, &opts);
     assert_eq!(bits(&full), bits(&render_on(1, &scene, 0, &opts)));

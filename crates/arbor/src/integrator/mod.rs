@@ -7,6 +7,7 @@ mod path;
 mod prune;
 mod ray_log;
 mod roulette;
+mod split;
 mod whitted;
 
 pub use debug::{DebugIntegrator, DebugView};

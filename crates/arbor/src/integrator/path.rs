@@ -4,7 +4,8 @@
 //!
 //! - Bounces: uniform over the hemisphere of the shading normal (pdf `1/2π`), or by the cosine with
 //!   `ImportanceSampling` (pdf `cos θ/π`). Mirrors, conductors and dielectrics follow one of their
-//!   lobes, picked in proportion to its weight, as delta directions. A material with both (a mirror
+//!   lobes, picked in proportion to its weight, as delta directions; a METU camera follows every lobe of
+//!   a refractive surface instead, as the course's renderer does ([`super::split`]). A material with both (a mirror
 //!   with a diffuse colour, the course's usual kind) is a mixture: the bounce follows its BRDF or its
 //!   lobes, chosen in proportion to the two parts' weights (the BRDF's `k_d + k_s` against the lobes'),
 //!   and light sampling serves its BRDF part.
@@ -29,6 +30,7 @@
 use super::hemisphere::{cosine_hemisphere, uniform_hemisphere};
 use super::offset::{shadow_ray, spawn_origin};
 use super::roulette::{self, MAX_BOUNCES};
+use super::split::{Branch, Branches};
 use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::Camera;
@@ -141,162 +143,204 @@ impl<'a> PathTracer<'a> {
         // The course's roulette's throughput: the product of the BRDF values met so far.
         let mut t = Color::ONE;
         let mut bounce = 0;
+        // Paths split at refractive surfaces ([`super::split`]) leave branches here.
+        let mut branches = Branches::default();
         loop {
-            let Some(h) = hit else {
-                let w = last.map_or(1.0, |(from, pdf)| {
-                    self.met_light_weight(scene.environment_light, from, ray.dir.normalize(), pdf)
-                });
-                l += beta * self.miss(&ray, bounce) * w;
-                break;
-            };
-            if let Some(absorption) = inside {
-                beta *= beer(absorption, h.t * ray.dir.length());
-            }
-            let mut s = scene.surface(&ray, &h);
-            let m = scene.material(&s);
-            // The vertex's own light goes to `l`, or under the course's roulette to `e` first, which the
-            // roulette then weighs.
-            let mut e = Color::ZERO;
-            let own = if course { &mut e } else { &mut l };
-            let emitted = scene.emitted(&s, -ray.dir);
-            if emitted != Color::ZERO {
-                let w = last.map_or(1.0, |(from, pdf)| {
-                    self.met_light_weight(scene.light_of(s.object), from, ray.dir.normalize(), pdf)
-                });
-                *own += beta * emitted * w;
-            }
-            // Only textured objects ask for their textures: the common case builds no shading terms.
-            let textured =
-                if scene.has_textures(s.object) { scene.textured(&ray, &h, &mut s, Default::default()) } else { None };
-            if let Some(c) = textured.and_then(|t| t.replace_all) {
-                *own += beta * c;
-                if course {
-                    roulette::course(t, e, &mut l, sample);
-                }
-                break;
-            }
-            // One by one: picked as a pair, the two colours went through memory in pieces of other
-            // sizes than they are read in, and the reads waited for the writes.
-            let kd = textured.as_ref().map_or(m.diffuse, |t| t.diffuse);
-            let ks = textured.as_ref().map_or(m.specular, |t| t.specular);
-            let d = ray.dir.normalize();
-            let wo = -d;
-            let front = d.dot(s.ng) < 0.0;
-            // Shade the side the ray arrives on.
-            let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
-            let brdf = &self.brdfs[s.material];
-            let local = front || !m.transmits();
-            // A material may have both a BRDF and a specular layer (a mirror with a diffuse colour): the
-            // bounce follows the BRDF with probability `p_brdf`, in proportion to the two parts' weights,
-            // and the layer's lobes otherwise; light sampling serves the BRDF part wherever it is.
-            let has_brdf = local && (kd != Color::ZERO || ks != Color::ZERO);
-            let lobes = if m.layer.is_some() {
-                let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
-                m.specular_lobes(d, n)
-            } else {
-                Vec::new()
-            };
-            let lobe_total: f32 = lobes.iter().map(|lb| luminance(lb.weight)).sum();
-            let p_brdf = match (m.layer.is_some(), has_brdf) {
-                (false, _) => 1.0,
-                (true, false) => 0.0,
-                (true, true) => {
-                    let b = luminance(kd) + luminance(ks);
-                    if b + lobe_total > 0.0 {
-                        b / (b + lobe_total)
-                    } else {
-                        0.0
-                    }
-                }
-            };
-            let at = Vertex { s: &s, ns, wo, kd, ks, brdf, f: brdf.constant(kd, ks), p_brdf, time: ray.time };
-
-            // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
-            if has_brdf {
-                let origin = spawn_origin(scene.offset, &s, ng);
-                // With one light or none the choice is fixed: a plain number, no padded dimension spent.
-                let pick = if self.several { sample.padded_1d() } else { sample.rng.next_f32() };
-                let u = sample.padded_2d();
-                if o.next_event {
-                    for &(i, sampled) in &self.always {
-                        // A delta light's numbers are never read: plain ones, not a padded dimension
-                        // (the independent sampler draws the same numbers either way).
-                        let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
-                        self.direct(&at, beta, origin, i, u, 1.0, log, own);
-                    }
-                    if let Some((i, chosen)) = self.choose_light(pick) {
-                        self.direct(&at, beta, origin, i, u, chosen, log, own);
-                    }
-                }
-            }
-            if course {
-                let Some(q) = roulette::course(t, e, &mut l, sample) else { break };
-                beta /= q;
-            }
-
-            if bounce >= max_bounces {
-                break;
-            }
-            // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
-            // With a layer, one number picks the part and, rescaled, the lobe.
-            let part = if m.layer.is_some() { sample.rng.next_f32() } else { 0.0 };
-            let next = if part >= p_brdf {
-                let total = lobe_total;
-                if total <= 0.0 {
-                    break;
-                }
-                let mut pick = (part - p_brdf) / (1.0 - p_brdf) * total;
-                let Some(lobe) = lobes.iter().find(|lb| {
-                    pick -= luminance(lb.weight);
-                    pick < 0.0
-                }) else {
+            loop {
+                let Some(h) = hit else {
+                    let w = last.map_or(1.0, |(from, pdf)| {
+                        self.met_light_weight(scene.environment_light, from, ray.dir.normalize(), pdf)
+                    });
+                    l += beta * self.miss(&ray, bounce) * w;
                     break;
                 };
-                beta *= lobe.weight * (total / luminance(lobe.weight));
-                if course {
-                    t *= lobe.weight;
+                if let Some(absorption) = inside {
+                    beta *= beer(absorption, h.t * ray.dir.length());
                 }
-                if p_brdf > 0.0 {
-                    beta /= 1.0 - p_brdf;
+                let mut s = scene.surface(&ray, &h);
+                let m = scene.material(&s);
+                // The vertex's own light goes to `l`, or under the course's roulette to `e` first, which the
+                // roulette then weighs.
+                let mut e = Color::ZERO;
+                let own = if course { &mut e } else { &mut l };
+                let emitted = scene.emitted(&s, -ray.dir);
+                if emitted != Color::ZERO {
+                    let w = last.map_or(1.0, |(from, pdf)| {
+                        self.met_light_weight(scene.light_of(s.object), from, ray.dir.normalize(), pdf)
+                    });
+                    *own += beta * emitted * w;
                 }
-                last = None;
-                inside = m.medium_after(lobe, front, inside);
-                lobe.dir
-            } else {
-                let (wi, pdf) = if o.importance_sampling {
-                    cosine_hemisphere(ns, sample.padded_2d())
+                // Only textured objects ask for their textures: the common case builds no shading terms.
+                let textured = if scene.has_textures(s.object) {
+                    scene.textured(&ray, &h, &mut s, Default::default())
                 } else {
-                    uniform_hemisphere(ns, sample.padded_2d())
+                    None
                 };
-                let cos = ns.dot(wi);
-                if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
+                if let Some(c) = textured.and_then(|t| t.replace_all) {
+                    *own += beta * c;
+                    if course {
+                        roulette::course(t, e, &mut l, sample);
+                    }
                     break;
                 }
-                let f = at.f(wi);
-                beta *= f * (cos / pdf);
+                // One by one: picked as a pair, the two colours went through memory in pieces of other
+                // sizes than they are read in, and the reads waited for the writes.
+                let kd = textured.as_ref().map_or(m.diffuse, |t| t.diffuse);
+                let ks = textured.as_ref().map_or(m.specular, |t| t.specular);
+                let d = ray.dir.normalize();
+                let wo = -d;
+                let front = d.dot(s.ng) < 0.0;
+                // Shade the side the ray arrives on.
+                let (ng, ns) = if front { (s.ng, s.ns) } else { (-s.ng, -s.ns) };
+                let brdf = &self.brdfs[s.material];
+                let local = front || !m.transmits();
+                // A material may have both a BRDF and a specular layer (a mirror with a diffuse colour): the
+                // bounce follows the BRDF with probability `p_brdf`, in proportion to the two parts' weights,
+                // and the layer's lobes otherwise; light sampling serves the BRDF part wherever it is.
+                let has_brdf = local && (kd != Color::ZERO || ks != Color::ZERO);
+                let lobes = if m.layer.is_some() {
+                    let n = if (d.dot(s.ns) < 0.0) == front { s.ns } else { s.ng };
+                    m.specular_lobes(d, n)
+                } else {
+                    Vec::new()
+                };
+                let lobe_total: f32 = lobes.iter().map(|lb| luminance(lb.weight)).sum();
+                // The course's renderer follows every lobe of a refractive surface and its BRDF bounce too.
+                let split = o.split_refraction
+                    && m.transmits()
+                    && bounce < scene.max_depth.min(max_bounces)
+                    && branches.room_for(&lobes);
+                let p_brdf = match (m.layer.is_some(), has_brdf) {
+                    _ if split => 1.0,
+                    (false, _) => 1.0,
+                    (true, false) => 0.0,
+                    (true, true) => {
+                        let b = luminance(kd) + luminance(ks);
+                        if b + lobe_total > 0.0 {
+                            b / (b + lobe_total)
+                        } else {
+                            0.0
+                        }
+                    }
+                };
+                let at = Vertex { s: &s, ns, wo, kd, ks, brdf, f: brdf.constant(kd, ks), p_brdf, time: ray.time };
+
+                // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
+                if has_brdf {
+                    let origin = spawn_origin(scene.offset, &s, ng);
+                    // With one light or none the choice is fixed: a plain number, no padded dimension spent.
+                    let pick = if self.several { sample.padded_1d() } else { sample.rng.next_f32() };
+                    let u = sample.padded_2d();
+                    if o.next_event {
+                        for &(i, sampled) in &self.always {
+                            // A delta light's numbers are never read: plain ones, not a padded dimension
+                            // (the independent sampler draws the same numbers either way).
+                            let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
+                            self.direct(&at, beta, origin, i, u, 1.0, log, own);
+                        }
+                        if let Some((i, chosen)) = self.choose_light(pick) {
+                            self.direct(&at, beta, origin, i, u, chosen, log, own);
+                        }
+                    }
+                }
                 if course {
-                    t *= f;
+                    let Some(q) = roulette::course(t, e, &mut l, sample) else { break };
+                    beta /= q;
                 }
-                if p_brdf < 1.0 {
-                    beta /= p_brdf;
+
+                if bounce >= max_bounces {
+                    break;
                 }
-                last = Some((s.p, p_brdf * pdf));
-                wi
-            };
-            if o.roulette == Roulette::Unbiased {
-                let Some(q) = roulette::unbiased(beta, sample) else { break };
-                beta /= q;
+                // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
+                // With a layer, one number picks the part and, rescaled, the lobe.
+                let part = if m.layer.is_some() && !split { sample.rng.next_f32() } else { 0.0 };
+                if split {
+                    branches.push(&lobes, |lobe| Branch {
+                        ray: Ray::new(spawn_origin(scene.offset, &s, lobe.dir), lobe.dir).with_time(ray.time),
+                        beta: beta * lobe.weight,
+                        t: if course { t * lobe.weight } else { t },
+                        inside: m.medium_after(lobe, front, inside),
+                        bounce: bounce + 1,
+                    });
+                    if !has_brdf {
+                        break;
+                    }
+                }
+                let next = if part >= p_brdf {
+                    let total = lobe_total;
+                    if total <= 0.0 {
+                        break;
+                    }
+                    let mut pick = (part - p_brdf) / (1.0 - p_brdf) * total;
+                    let Some(lobe) = lobes.iter().find(|lb| {
+                        pick -= luminance(lb.weight);
+                        pick < 0.0
+                    }) else {
+                        break;
+                    };
+                    beta *= lobe.weight * (total / luminance(lobe.weight));
+                    if course {
+                        t *= lobe.weight;
+                    }
+                    if p_brdf > 0.0 {
+                        beta /= 1.0 - p_brdf;
+                    }
+                    last = None;
+                    inside = m.medium_after(lobe, front, inside);
+                    lobe.dir
+                } else {
+                    let (wi, pdf) = if o.importance_sampling {
+                        cosine_hemisphere(ns, sample.padded_2d())
+                    } else {
+                        uniform_hemisphere(ns, sample.padded_2d())
+                    };
+                    let cos = ns.dot(wi);
+                    if pdf <= 0.0 || cos <= 0.0 || wi.dot(ng) <= 0.0 {
+                        break;
+                    }
+                    let f = at.f(wi);
+                    beta *= f * (cos / pdf);
+                    if course {
+                        t *= f;
+                    }
+                    if p_brdf < 1.0 {
+                        beta /= p_brdf;
+                    }
+                    last = Some((s.p, p_brdf * pdf));
+                    wi
+                };
+                if o.roulette == Roulette::Unbiased {
+                    let Some(q) = roulette::unbiased(beta, sample) else { break };
+                    beta /= q;
+                }
+                if beta == Color::ZERO {
+                    break;
+                }
+                bounce += 1;
+                let origin = spawn_origin(scene.offset, &s, next);
+                ray = Ray::new(origin, next).with_time(ray.time);
+                log.rays += 1;
+                hit = log.intersect(&scene.geometry, &ray, f32::INFINITY);
             }
-            if beta == Color::ZERO {
-                break;
-            }
-            bounce += 1;
-            let origin = spawn_origin(scene.offset, &s, next);
-            ray = Ray::new(origin, next).with_time(ray.time);
+            let Some(b) = self.next_branch(&mut branches, sample) else { break };
+            (ray, beta, t, inside, bounce, last) = (b.ray, b.beta, b.t, b.inside, b.bounce, None);
             log.rays += 1;
             hit = log.intersect(&scene.geometry, &ray, f32::INFINITY);
         }
         l
+    }
+
+    /// The next branch of a split path to trace, after Arbor's unbiased roulette (the roulette a bounce
+    /// gets before its ray is traced) where the camera has it.
+    fn next_branch(&self, branches: &mut Branches, sample: &mut SampleStream) -> Option<Branch> {
+        while let Some(mut b) = branches.pop() {
+            if self.options.roulette == Roulette::Unbiased {
+                let Some(q) = roulette::unbiased(b.beta, sample) else { continue };
+                b.beta /= q;
+            }
+            return Some(b);
+        }
+        None
     }
 
     /// Adds to `l` the light `i` brings to the vertex `at` of throughput `beta` through one sample `u` of

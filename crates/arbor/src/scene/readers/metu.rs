@@ -470,15 +470,20 @@ mod tests {
             read_xml(&format!("<MaxRecursionDepth>{depth}</MaxRecursionDepth>{}", camera(extra)))
         };
         let d = read(3, "<Renderer>PathTracing</Renderer>").unwrap();
-        assert_eq!(d.cameras[0].renderer, Renderer::PathTracing(PathOptions::default()));
+        // The course's renderer splits at refractive surfaces: its cameras do.
+        let course = PathOptions { split_refraction: true, ..PathOptions::default() };
+        assert_eq!(d.cameras[0].renderer, Renderer::PathTracing(course));
         assert!(d.warnings.is_empty(), "{:?}", d.warnings);
         let all = "<Renderer>PathTracing</Renderer><RendererParams> NextEventEstimation ImportanceSampling \
                    RussianRoulette</RendererParams>";
-        let want = PathOptions { next_event: true, importance_sampling: true, roulette: Roulette::Course, mis: false };
+        let want = PathOptions { next_event: true, importance_sampling: true, roulette: Roulette::Course, ..course };
         assert_eq!(read(3, all).unwrap().cameras[0].renderer, Renderer::PathTracing(want));
         // MIS brings the two samplings it weighs.
         let mis = read(3, "<Renderer>PathTracing</Renderer><RendererParams>MIS</RendererParams>").unwrap();
-        assert_eq!(mis.cameras[0].renderer, Renderer::PathTracing(PathOptions::DEFAULT));
+        assert_eq!(
+            mis.cameras[0].renderer,
+            Renderer::PathTracing(PathOptions { split_refraction: true, ..PathOptions::DEFAULT })
+        );
         assert_eq!(read(3, "").unwrap().cameras[0].renderer, Renderer::Whitted);
         let lone = read(3, "<RendererParams>MIS</RendererParams>").unwrap();
         assert_eq!(

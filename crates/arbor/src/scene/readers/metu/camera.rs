@@ -188,7 +188,8 @@ impl Reader<'_> {
                 Ok(Renderer::Whitted)
             }
             Some((n, "PathTracing")) => {
-                let mut o = PathOptions::default();
+                // The course's renderer splits at refractive surfaces.
+                let mut o = PathOptions { split_refraction: true, ..PathOptions::default() };
                 for word in params.map_or("", |n| n.trimmed()).split_whitespace() {
                     let flag = match word {
                         "NextEventEstimation" => &mut o.next_event,
