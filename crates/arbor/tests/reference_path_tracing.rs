@@ -51,15 +51,6 @@ const BLOCK: u32 = 16;
 const KNOWN_FAILURES: &[&str] = &[
     // The official image has 2.5 to 4 times Arbor's count of pixels above 100 (fireflies).
     "ceng795-2022/hw6/pathTracing/outputs/diffuse_next_importance_russian.png",
-    // The glass sphere without next event estimation: 26% of its pixels black in the reference, 59%
-    // in Arbor's render (the same share as the 2022 glass, whose radiance passes), and the 8-bit
-    // curve turns that into 20 to 55 levels. The official renderer splits at the glass (both Fresnel
-    // lobes traced), and its PNGs of these cameras are exposed 13-31% brighter than their own
-    // radiance's log-average gives: passing needs both (docs/reference-results.md).
-    "ceng795-2019/inputs/hw6/pathTracing/glass.png",
-    "ceng795-2019/inputs/hw6/pathTracing/glass_importance.png",
-    "ceng795-2019/inputs/hw6/pathTracing/glass_russian.png",
-    "ceng795-2019/inputs/hw6/pathTracing/glass_importance_russian.png",
 ];
 
 /// One camera of a scene file and its reference image.
