@@ -67,3 +67,36 @@ impl Branches {
         self.pending.pop()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn lobe(weight: f32) -> Lobe {
+        Lobe { dir: Vec3::Z, weight: Color::splat(weight), transmitted: false }
+    }
+
+    fn branch(bounce: u32) -> impl Fn(&Lobe) -> Branch {
+        move |lb| Branch { ray: Ray::new(Vec3::ZERO, lb.dir), beta: lb.weight, t: Color::ONE, inside: None, bounce }
+    }
+
+    #[test]
+    fn branches_come_back_in_lobe_order_and_stop_at_the_bound() {
+        let mut b = Branches::default();
+        let two = [lobe(0.25), lobe(0.75)];
+        b.push(&two, branch(1));
+        // A lobe of zero weight brings nothing: no branch, but it counts against the bound.
+        b.push(&[lobe(0.0)], branch(2));
+        assert_eq!(b.pop().map(|x| x.beta.x), Some(0.25));
+        assert_eq!(b.pop().map(|x| x.beta.x), Some(0.75));
+        assert!(b.pop().is_none());
+        // 3 made; room for 61 more, in pairs up to 63, then no pair fits.
+        for _ in 0..30 {
+            assert!(b.room_for(&two));
+            b.push(&two, branch(1));
+        }
+        assert_eq!(b.made, 63);
+        assert!(b.room_for(&[lobe(1.0)]) && !b.room_for(&two));
+    }
+}
