@@ -5,8 +5,9 @@ Each METU scene (XML) is translated into a Mitsuba scene dict -- same camera, tr
 Lambertian albedo, glass and mirrors, mesh/sphere lights and point lights, path length -- and rendered
 with Mitsuba's `path` integrator in its `scalar_rgb` and `llvm_ad_rgb` variants (the LLVM one once
 untimed first, to compile), and with `arbor render --integrator path --path-options mis` (the same
-estimator as Mitsuba's: cosine-sampled bounces and light samples weighted by MIS; --arbor-path-options
-picks another, '' the scene's RendererParams), at the same samples per pixel
+estimator as Mitsuba's: cosine-sampled bounces and light samples weighted by MIS, one lobe of a glass
+picked at random; --arbor-path-options picks another, '' the scene's RendererParams, which also follow
+both lobes of glass as the course's renderer does: unbiased either way), at the same samples per pixel
 on each thread count. For every render it prints samples per second (width x height x spp / seconds
 of rendering, scene loading excluded; Arbor's `render_ms` of its `--stats-json`), the RMSE in
 linear radiance against a high-spp render of each renderer (cached in --cache, rendered with another
