@@ -350,7 +350,7 @@ fn cli_diff_hdr_images_in_the_reference_curve() {
 
 #[test]
 fn cli_diff_noise_tonemap_shows_radiance_under_the_exposure_an_8bit_reference_implies() {
-    use arbor::tonemap::{Exposure, Tonemap};
+    use arbor::tonemap::Tonemap;
     let tmp = tempfile::tempdir().unwrap();
     // A ramp of radiance, and the course's curve of it at 1.3 times its own exposure as the reference.
     let ramp = |x: u32, y: u32| 0.05 + (x + 32 * y) as f32 / 256.0;
@@ -360,7 +360,7 @@ fn cli_diff_noise_tonemap_shows_radiance_under_the_exposure_an_8bit_reference_im
     let tm = Tonemap { key: 0.18, burn_percent: 1.0, saturation: 1.0, gamma: 2.2, ..Tonemap::PREVIEW };
     let film = arbor::image_io::read_image(&tmp.path().join("seed1.exr")).unwrap();
     let own = tm.exposure(&film);
-    let shown = tm.apply_exposure(&film, Exposure { scale: own.scale * 1.3, white: own.white.map(|w| w * 1.3) });
+    let shown = tm.apply_exposure(&film, own.scaled(1.3));
     let px = shown.to_rgb8();
     ppm(tmp.path(), "ref.ppm", 32, 32, |x, y| {
         let i = 3 * (32 * y + x) as usize;

@@ -54,6 +54,14 @@ pub struct Exposure {
     pub white: Option<f64>,
 }
 
+impl Exposure {
+    /// This exposure made `k` times brighter: the scale and the burn-out white together, as the scaled
+    /// luminance of a film `k` times brighter would give them.
+    pub fn scaled(self, k: f64) -> Exposure {
+        Exposure { scale: self.scale * k, white: self.white.map(|w| w * k) }
+    }
+}
+
 /// Luminance of a linear sRGB colour.
 pub fn luminance(c: Color) -> f32 {
     c.dot(LUMINANCE)

@@ -21,7 +21,7 @@
 
 use super::levels::{BlockLevels, DisplayCurve};
 use crate::film::Film;
-use crate::tonemap::{Exposure, Tonemap};
+use crate::tonemap::Tonemap;
 
 /// Levels the render may be farther from the reference than from its second seed.
 pub const NOISE_MARGIN: f64 = 1.0;
@@ -125,8 +125,8 @@ pub fn compare_noisy_tonemapped(
     let (w, h) = (render.width, render.height);
     let reference = BlockLevels::of_rgb8(reference, w, h, block);
     let own = tonemap.exposure(render);
-    let at = |k: f64| Exposure { scale: own.scale * k, white: own.white.map(|x| x * k) };
-    let levels = |f: &Film, k: f64| BlockLevels::of_rgb8(&tonemap.apply_exposure(f, at(k)).to_rgb8(), w, h, block);
+    let levels =
+        |f: &Film, k: f64| BlockLevels::of_rgb8(&tonemap.apply_exposure(f, own.scaled(k)).to_rgb8(), w, h, block);
     let cost = |x: f64| {
         let k = x.exp();
         levels(render, k).mean_abs_diff(&reference) + levels(other_seed, k).mean_abs_diff(&reference)
@@ -223,8 +223,7 @@ mod tests {
         let tm = Tonemap { burn_percent: 1.0, ..Tonemap::PREVIEW };
         let film = ramp(1.0);
         let own = tm.exposure(&film);
-        let exposed = Exposure { scale: own.scale * 1.3, white: own.white.map(|w| w * 1.3) };
-        let reference = tm.apply_exposure(&film, exposed).to_rgb8();
+        let reference = tm.apply_exposure(&film, own.scaled(1.3)).to_rgb8();
         // Under its own exposure the same radiance is a biased image...
         let plain = tm.apply(&film).to_rgb8();
         assert!(!compare_noisy_rgb8(&reference, &plain, &plain, 32, 32, 8).passes());
