@@ -67,11 +67,9 @@ fn parse_percent(s: &str) -> Result<f64, String> {
 
 /// Parses `--tonemap KEY,BURN,SATURATION,GAMMA` into the photographic operator, in the scene's units.
 fn parse_tonemap(s: &str) -> Result<Tonemap, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("'{s}' is not four numbers KEY,BURN,SATURATION,GAMMA (the course's: 0.18,1,1,2.2)"))?;
+    let not_four = || format!("'{s}' is not four numbers KEY,BURN,SATURATION,GAMMA (the course's: 0.18,1,1,2.2)");
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| not_four())?;
     match v[..] {
         [key, burn, saturation, gamma]
             if key > 0.0 && (0.0..=100.0).contains(&burn) && saturation >= 0.0 && gamma > 0.0 && v.iter().all(|x| x.is_finite()) =>
@@ -81,7 +79,7 @@ fn parse_tonemap(s: &str) -> Result<Tonemap, String> {
         [_, _, _, _] => Err(format!(
             "'{s}': the key and gamma must be positive, the burn-out a percentage from 0 to 100, the saturation at least 0"
         )),
-        _ => Err(format!("'{s}' is not four numbers KEY,BURN,SATURATION,GAMMA (the course's: 0.18,1,1,2.2)")),
+        _ => Err(not_four()),
     }
 }
 
@@ -124,6 +122,15 @@ impl Read {
     }
 }
 
+/// An image of size `got` against a reference of size `want`: an error naming `path` when they differ.
+fn same_size(path: &Path, got: (u32, u32), want: (u32, u32)) -> Result<(), Failure> {
+    if got == want {
+        return Ok(());
+    }
+    let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
+    Err(arbor::Error::Invalid(msg).into())
+}
+
 /// Reads the reference and `images` (each fails as a file first), then checks that they are all 8-bit or
 /// all HDR, and all of one size.
 fn read_all(reference: &Path, images: &[&PathBuf], limits: &ImageLimits) -> Result<Images, Failure> {
@@ -141,11 +148,7 @@ fn read_all(reference: &Path, images: &[&PathBuf], limits: &ImageLimits) -> Resu
                 reference.display()
             )));
         }
-        let got = read.size();
-        if got != want {
-            let msg = format!("{} is {}x{} but the reference is {}x{}", path.display(), got.0, got.1, want.0, want.1);
-            return Err(arbor::Error::Invalid(msg).into());
-        }
+        same_size(path, read.size(), want)?;
     }
     Ok(match first {
         Read::Hdr(reference) => Images::Hdr {
@@ -231,10 +234,7 @@ fn tonemapped(
                 path.display()
             )));
         };
-        if (film.width, film.height) != (w, h) {
-            let msg = format!("{} is {}x{} but the reference is {w}x{h}", path.display(), film.width, film.height);
-            return Err(arbor::Error::Invalid(msg).into());
-        }
+        same_size(path, (film.width, film.height), (w, h))?;
         films.push(film);
     }
     say!("8-bit reference: the renders' radiance through the tone curve, under the exposure that fits it best");
@@ -243,13 +243,13 @@ fn tonemapped(
 
 /// Runs `arbor diff`.
 pub fn run(args: DiffArgs) -> Result<(), Failure> {
-    let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
     let limits = crate::render::limits(args.no_limits).rendered();
     if let (Some(tonemap), Some(other)) = (&args.tonemap, &args.noise) {
         let c = tonemapped(&args, tonemap, other, &limits)?;
         say!("{}", c.summary());
         return if c.passes() { Ok(()) } else { Err(Failure::TooDifferent) };
     }
+    let paths: Vec<&PathBuf> = std::iter::once(&args.image).chain(&args.noise).collect();
     let images = read_all(&args.reference, &paths, &limits)?;
     if matches!(images, Images::Hdr { .. }) {
         say!(
