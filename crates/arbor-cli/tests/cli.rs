@@ -382,6 +382,10 @@ fn cli_diff_noise_tonemap_shows_radiance_under_the_exposure_an_8bit_reference_im
     let o = arbor(&["diff", "ref.ppm", "ref.ppm", "--noise", "seed2.exr", "--tonemap", "0.18,1,1,2.2"], tmp.path());
     let want = "error: ref.ppm is an 8-bit image: with --tonemap the two renders are radiance (.exr, .hdr)\n";
     assert_eq!((o.status.code(), stderr(&o)), (Some(2), want.to_string()));
+    exr(tmp.path(), "small.exr", 16, 16, ramp);
+    let o = arbor(&args("seed1.exr", "small.exr"), tmp.path());
+    let want = "error: small.exr is 16x16 but the reference is 32x32\n";
+    assert_eq!((o.status.code(), stderr(&o)), (Some(3), want.to_string()));
     let o = arbor(&["diff", "ref.ppm", "seed1.exr", "--noise", "seed2.exr", "--tonemap", "0.18,1,1,0"], tmp.path());
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("the key and gamma must be positive"), "{}", stderr(&o));
