@@ -300,9 +300,11 @@ async function rebuild() {
   const spec = state.scene.kinds.find((k) => k.kind === kind);
   const params = {};
   for (const p of spec.params) params[p.key] = $(`param-${p.key}`).value;
+  // Said before the request: a small structure's "done" event can arrive before the request returns,
+  // and must not be overwritten by "building" afterwards.
+  $("build-status").textContent = `building ${kind}…`;
   try {
     await api("/api/accel", { method: "POST", body: JSON.stringify({ kind, params }) });
-    $("build-status").textContent = `building ${kind}…`;
   } catch (e) {
     $("build-status").textContent = e.message;
   }
