@@ -16,7 +16,7 @@ use crate::math::{Ray, Vec3};
 use crate::test_rng::Rng;
 
 /// An `n` x `n` grid of unit squares in `z = 0`, two triangles each, vertices on the integers.
-fn grid(n: u32) -> TriangleMesh {
+pub(super) fn grid(n: u32) -> TriangleMesh {
     let mut positions = Vec::new();
     for j in 0..=n {
         for i in 0..=n {

@@ -386,7 +386,7 @@ fn median_sah_cost_is_within_a_sane_factor_of_binned_sah() {
 }
 
 /// Primitives that are not a mesh, so the wide tree asks them through `Primitives` (no triangle copy).
-struct Opaque<'a>(&'a TriangleMesh);
+pub(super) struct Opaque<'a>(pub(super) &'a TriangleMesh);
 
 impl Primitives for Opaque<'_> {
     fn len(&self) -> usize {
@@ -420,7 +420,7 @@ fn bvh_wide_traversal_matches_binary_traversal_with_and_without_triangle_copy() 
 }
 
 /// The node-test kernels this processor runs, scalar first.
-fn kernels() -> Vec<super::wide::Kernel> {
+pub(super) fn kernels() -> Vec<super::wide::Kernel> {
     use super::wide::Kernel;
     #[allow(unused_mut)] // only x86_64 has more than the scalar kernel
     let mut kernels = vec![Kernel::Scalar];

@@ -295,26 +295,34 @@ impl NodeTest for Scalar {
     /// The same test one lane at a time.
     #[inline(always)]
     fn test(self, lanes: &Lanes, node: &Node8, t_far: f32) -> Tested {
-        let flat = float_view(node);
         let mut near_out = [0.0f32; WIDTH];
         let mut slack_out = [0.0f32; WIDTH];
         let mut mask = 0;
         for lane in 0..WIDTH {
-            let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
-            for a in 0..3 {
-                let t0 = (flat[lanes.enter[a] + lane] - lanes.org[a]) * lanes.inv[a];
-                let t1 = (flat[lanes.exit[a] + lane] - lanes.org[a]) * lanes.inv[a];
-                near = near.max(t0);
-                far = far.min(t1);
-                if a == lanes.major {
-                    scale = t0.abs().max(t1.abs());
-                }
-            }
-            let slack = scale * BOX_SLACK;
+            let (hit, near, slack) = lane_test(lanes, node, lane, t_far);
             near_out[lane] = near;
             slack_out[lane] = slack;
-            mask |= ((near <= far + slack) as u32) << lane;
+            mask |= (hit as u32) << lane;
         }
         (mask, near_out, slack_out)
     }
+}
+
+/// One lane of the node test: whether `lanes`' ray meets the box of `node`'s lane `lane` in
+/// `[0, t_far]`, its entry distance and its slack; the arithmetic of every kernel, lane by lane.
+#[inline(always)]
+pub(super) fn lane_test(lanes: &Lanes, node: &Node8, lane: usize, t_far: f32) -> (bool, f32, f32) {
+    let flat = float_view(node);
+    let (mut near, mut far, mut scale) = (0.0f32, t_far, 0.0f32);
+    for a in 0..3 {
+        let t0 = (flat[lanes.enter[a] + lane] - lanes.org[a]) * lanes.inv[a];
+        let t1 = (flat[lanes.exit[a] + lane] - lanes.org[a]) * lanes.inv[a];
+        near = near.max(t0);
+        far = far.min(t1);
+        if a == lanes.major {
+            scale = t0.abs().max(t1.abs());
+        }
+    }
+    let slack = scale * BOX_SLACK;
+    (near <= far + slack, near, slack)
 }

@@ -29,7 +29,8 @@
 //! The collapse is in `collapse.rs` (and `walk.rs`, its one-thread form). Queries, one job per file: the node test in four kernels (`kernel.rs`), what a query does at a
 //! leaf (`leaves.rs`), the dispatch over kernel and kind of leaf (`dispatch.rs`), the node visit and pop
 //! shared by the closest-hit queries (`visit.rs`), the closest-hit query (`closest.rs`), its batch form
-//! (`batch.rs`), the any-hit query (`any_hit.rs`) and the closest-point query (`nearest.rs`).
+//! (`batch.rs`) and its packets of coherent rays (`packet.rs`), the any-hit query (`any_hit.rs`) and the
+//! closest-point query (`nearest.rs`).
 
 mod any_hit;
 mod batch;
@@ -41,6 +42,9 @@ mod dispatch;
 mod kernel;
 mod leaves;
 mod nearest;
+mod packet;
+#[cfg(test)]
+mod packet_tests;
 mod visit;
 mod walk;
 
