@@ -89,6 +89,11 @@ impl<P: Primitives + ?Sized + Send + 'static> Structure<P> {
         self.accel.intersect_many(&self.prims, rays, t_max, out);
     }
 
+    /// [`Structure::intersect_many`] for rays in a coherent order ([`Accel::intersect_many_coherent`]).
+    pub fn intersect_many_coherent(&self, rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]) {
+        self.accel.intersect_many_coherent(&self.prims, rays, t_max, out);
+    }
+
     /// Whether anything is hit in `(0, t_max)` (shadow rays); stops at the first hit found.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.accel.occluded(&self.prims, ray, t_max)

@@ -325,6 +325,10 @@ impl<P: Primitives + ?Sized> Accel<P> for Bvh {
         wide::intersect_many_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
     }
 
+    fn intersect_many_coherent(&self, prims: &P, rays: &[Ray], t_max: &[f32], out: &mut [Option<Hit>]) {
+        wide::intersect_coherent_with(Kernel::detect(), &self.wide, &self.prim_indices, prims, rays, t_max, out)
+    }
+
     fn boxes_at_depth(&self, prims: &P, depth: usize) -> Vec<Aabb> {
         if self.binary_dropped() {
             return Accel::<P>::boxes_at_depth(&self.recipe.build_kept(prims), prims, depth);

@@ -1,7 +1,8 @@
 //! Queries for a batch of rays on the 8-wide tree, two rays at once: one step of each in turn
 //! ([`Walker`]). A node visit is a chain of dependent loads and arithmetic that one ray cannot overlap
 //! with its next visit, which depends on it, but the other ray's visit can fill that wait. Closest hits
-//! ([`intersect_many_with`], whose walk is here; coherent runs of rays go as packets, `packet.rs`) and
+//! ([`intersect_many_with`], whose walk is here; its coherent form's runs of rays go as packets,
+//! `packet.rs`) and
 //! any hits ([`super::occluded_many_with`], whose walk is in `any_hit.rs`) share the interleaving
 //! ([`many`]). Each walk's node visit and pop are those of its single query, so each ray visits the same
 //! nodes and gets the same answer as it would alone. The counted query stays one ray at a time.
@@ -11,7 +12,6 @@ use std::marker::PhantomData;
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{Kernel, Lanes, NodeTest};
 use super::leaves::{prepare, LeafRay, Leaves};
-use super::packet::Coherent;
 use super::visit::{new_stack, pop, visit, Stack};
 use super::{Node8, Ref, Wide};
 use crate::accel::closest::{trivially_misses, ClosestHit};
@@ -29,8 +29,7 @@ pub(in crate::accel::bvh) fn intersect_many_with<P: Primitives + ?Sized>(
     t_max: &[f32],
     out: &mut [Option<Hit>],
 ) {
-    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and answers differ in length");
-    run_with(kernel, wide, indices, prims, Coherent { rays, t_max, out })
+    run_with(kernel, wide, indices, prims, Batch::<ClosestWalk>::new(rays, t_max, out))
 }
 
 /// The queries of a batch, each ray walked by a `W`.

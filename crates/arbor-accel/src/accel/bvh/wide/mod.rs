@@ -57,6 +57,7 @@ pub(super) use kernel::Kernel;
 #[cfg(test)]
 pub(super) use kernel::{Avx2, Avx512};
 pub(super) use nearest::closest_point;
+pub(super) use packet::intersect_coherent_with;
 
 use super::Node;
 use crate::accel::Primitives;

@@ -26,13 +26,13 @@
 use std::mem::MaybeUninit;
 
 use super::batch::{many, ClosestWalk};
-use super::dispatch::Traversal;
-use super::kernel::{lane_test, Lanes, NodeTest};
+use super::dispatch::{run_with, Traversal};
+use super::kernel::{lane_test, Kernel, Lanes, NodeTest};
 use super::leaves::{prepare, LeafRay, Leaves};
 use super::visit::STACK;
-use super::{Node8, Ref, WIDTH};
+use super::{Node8, Ref, Wide, WIDTH};
 use crate::accel::closest::{trivially_misses, ClosestHit};
-use crate::accel::{Hit, TraversalCounts, BOX_SLACK};
+use crate::accel::{Hit, Primitives, TraversalCounts, BOX_SLACK};
 use crate::geometry::major_axis;
 use crate::math::{Ray, Vec3};
 
@@ -44,12 +44,30 @@ pub(super) const MIN_PACKET: usize = 4;
 /// spread of its origins (per axis, as a share of the diagonal of the tree's box).
 const MAX_SPREAD: f32 = 1.0 / 64.0;
 
-/// The closest hits of a batch (`out[i]` for `rays[i]` in `(0, t_max[i])`): packets where consecutive
-/// rays form them, the two-ray interleaved walk for the rest.
-pub(super) struct Coherent<'a> {
-    pub(super) rays: &'a [Ray],
-    pub(super) t_max: &'a [f32],
-    pub(super) out: &'a mut [Option<Hit>],
+/// Closest-hit queries for a batch of rays in a coherent order with `kernel`'s node test, `out[i]` for
+/// `rays[i]` in `(0, t_max[i])`: the same hits as [`super::intersect_with`] ray by ray, packets where
+/// consecutive rays form them, the two-ray interleaved walk for the rest.
+///
+/// # Panics
+/// When `rays`, `t_max` and `out` differ in length.
+pub(in crate::accel::bvh) fn intersect_coherent_with<P: Primitives + ?Sized>(
+    kernel: Kernel,
+    wide: &Wide,
+    indices: &[u32],
+    prims: &P,
+    rays: &[Ray],
+    t_max: &[f32],
+    out: &mut [Option<Hit>],
+) {
+    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and answers differ in length");
+    run_with(kernel, wide, indices, prims, Coherent { rays, t_max, out })
+}
+
+/// The queries of [`intersect_coherent_with`].
+struct Coherent<'a> {
+    rays: &'a [Ray],
+    t_max: &'a [f32],
+    out: &'a mut [Option<Hit>],
 }
 
 impl Traversal for Coherent<'_> {

@@ -4,7 +4,7 @@
 //! ties between duplicated triangles, and packets broken by rays that trivially miss or end early.
 
 use super::packet::{packet_len, MIN_PACKET, PACKET};
-use super::{intersect_many_with, Kernel};
+use super::{intersect_coherent_with, Kernel};
 use crate::accel::bvh::tests::{bits, kernels, soup, Opaque};
 use crate::accel::bvh::{Bvh, BvhParams};
 use crate::accel::watertight_tests::grid;
@@ -97,13 +97,17 @@ fn bvh_packets_of_coherent_rays_keep_brute_forces_hits_with_every_kernel_and_lea
         let want: Vec<_> = rays.iter().zip(&t_max).map(|(r, &t)| bits(brute.intersect(&mesh, r, t))).collect();
         let hits = want.iter().filter(|h| h.is_some()).count();
         assert!(name == "grazing" || 8 * hits >= rays.len(), "{name}: the rays must hit ({hits} of {})", rays.len());
+        // Through the trait, as the Python module calls it.
+        let mut out = vec![None; rays.len()];
+        with_copy.intersect_many_coherent(&mesh, &rays, &t_max, &mut out);
+        assert_eq!(out.iter().map(|&h| bits(h)).collect::<Vec<_>>(), want, "{name}, intersect_many_coherent");
         for k in kernels().into_iter().chain([Kernel::Scalar]) {
             let mut out = vec![None; rays.len()];
-            intersect_many_with(k, &with_copy.wide, &with_copy.prim_indices, &mesh, &rays, &t_max, &mut out);
+            intersect_coherent_with(k, &with_copy.wide, &with_copy.prim_indices, &mesh, &rays, &t_max, &mut out);
             for (i, h) in out.iter().enumerate() {
                 assert_eq!(bits(*h), want[i], "{name}, {k:?}, mesh leaves, ray {i} {:?}", rays[i]);
             }
-            intersect_many_with(k, &without.wide, &without.prim_indices, &opaque, &rays, &t_max, &mut out);
+            intersect_coherent_with(k, &without.wide, &without.prim_indices, &opaque, &rays, &t_max, &mut out);
             for (i, h) in out.iter().enumerate() {
                 assert_eq!(bits(*h), want[i], "{name}, {k:?}, primitive leaves, ray {i} {:?}", rays[i]);
             }
