@@ -2,8 +2,8 @@
 //! on a rayon pool of the threads asked for, in chunks of [`CHUNK`] rays: each chunk is one
 //! `intersect_many_coherent`/`occluded_many` call, so the BVH's interleaved two-ray traversal serves
 //! Python callers as it serves the renderer's camera rays, and runs of rays in a coherent order (a
-//! scanner's rows, a camera's pixels: arrays are often made so) go as packets, about 1.2x on parallel
-//! rays (docs/performance.md); closest points likewise, in `f64` from the points as given. No query
+//! scanner's rows, a camera's pixels: arrays are often made so) go as packets (igea's parallel rays
+//! 1.13x, the icosphere's sparser ones 0.96x: docs/performance.md); closest points likewise, in `f64` from the points as given. No query
 //! here takes the GIL.
 //!
 //! Costs outside the traversal, kept small because a closest-hit query of a coherent ray costs only

@@ -21,7 +21,9 @@
 //! paid once per packet; leaves are paid per ray, for the union of the leaves the packet meets. Rays that
 //! form no packet keep the two-ray interleaved walk (`batch.rs`). A packet needs its rays' direction
 //! signs, zero components and major axis to agree; beyond that, spreads that make the boxes' intervals
-//! loose cost time, never hits, so [`MAX_SPREAD`] only keeps the test worth its price.
+//! loose cost time, never hits, so [`MAX_SPREAD`] only keeps the test worth its price; and where rays
+//! are sparser than the leaves a packet's rays part at once, so one that makes more node tests than it
+//! has rays sends the next [`SKIP`] rays the single way.
 
 use std::mem::MaybeUninit;
 
@@ -38,6 +40,8 @@ use crate::math::{Ray, Vec3};
 
 /// Most rays in a packet.
 pub(super) const PACKET: usize = 16;
+/// Rays sent the single way after a packet that did not pay ([`Coherent`]).
+const SKIP: usize = 256;
 /// Fewest rays worth a packet: below it the rays go the single way.
 pub(super) const MIN_PACKET: usize = 4;
 /// Largest sine of the angle between a packet's first direction and each other one, and largest
@@ -85,9 +89,9 @@ impl Traversal for Coherent<'_> {
         // Where rays form no packet, the next attempt backs off (doubling, up to 256 rays), so that
         // incoherent rays pay next to nothing for the attempts. One call of the interleaved walk, for
         // the rays up to the next packet, keeps its code in one place.
-        let (n, mut start) = (rays.len(), 0);
+        let (n, mut start, mut skip) = (rays.len(), 0, 0);
         while start < n {
-            let (mut i, mut backoff, mut found) = (start, 1, None);
+            let (mut i, mut backoff, mut found) = (start + skip, 1, None);
             while i < n && size.is_finite() {
                 found = packet(&rays[i..], &t_max[i..], size);
                 if found.is_some() {
@@ -109,7 +113,12 @@ impl Traversal for Coherent<'_> {
                 );
             }
             let Some((len, bounds)) = found else { break };
-            trace(nodes, leaves, root, &bounds, &rays[i..i + len], &t_max[i..i + len], &mut out[i..i + len]);
+            let tests =
+                trace(nodes, leaves, root, &bounds, &rays[i..i + len], &t_max[i..i + len], &mut out[i..i + len]);
+            // A packet whose rays went separate ways (rays sparser than the leaves: more than one node
+            // test per ray, each about three single visits) costs more than its rays alone: the next
+            // rays of the batch go the single way before packets are tried again.
+            skip = if tests > len { SKIP } else { 0 };
             start = i + len;
         }
     }
@@ -275,7 +284,8 @@ struct Entry {
     lane: u32,
 }
 
-/// The closest hits of the packet `rays` (in `(0, t_max[i])`) into `out`, from `root`.
+/// The closest hits of the packet `rays` (in `(0, t_max[i])`) into `out`, from `root`; returns the
+/// number of node tests it made.
 #[inline(always)]
 fn trace<L: Leaves>(
     nodes: &[Node8],
@@ -285,7 +295,7 @@ fn trace<L: Leaves>(
     rays: &[Ray],
     t_max: &[f32],
     out: &mut [Option<Hit>],
-) {
+) -> usize {
     let n = rays.len();
     debug_assert!((MIN_PACKET..=PACKET).contains(&n));
     let mut q: [Option<(Lanes, LeafRay)>; PACKET] = Default::default();
@@ -298,7 +308,7 @@ fn trace<L: Leaves>(
     let mut far = t_far(&best);
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
     stack[0] = MaybeUninit::new(Entry { r: root, near: 0.0, slack: 0.0, node: u32::MAX, lane: 0 });
-    let mut sp = 1;
+    let (mut sp, mut tests) = (1, 0);
     while sp > 0 {
         sp -= 1;
         // SAFETY: the entries below `sp` were written (the root, then each node's children).
@@ -325,6 +335,7 @@ fn trace<L: Leaves>(
         }
         let node = &nodes[e.r.child as usize];
         let (mask, near, slack) = bounds.test(node, far);
+        tests += 1;
         // Farthest first, so that the nearest child is popped next.
         let base = sp;
         let mut m = mask;
@@ -346,4 +357,5 @@ fn trace<L: Leaves>(
     for i in 0..n {
         out[i] = best[i].hit();
     }
+    tests
 }
