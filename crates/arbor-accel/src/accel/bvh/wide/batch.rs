@@ -46,12 +46,15 @@ impl<'a, W: Walker<'a>> Batch<'a, W> {
     /// # Panics
     /// When `rays`, `t_max` and `out` differ in length.
     pub(super) fn new(rays: &'a [Ray], t_max: &'a [f32], out: &'a mut [W::Out]) -> Self {
-        assert!(
-            rays.len() == t_max.len() && rays.len() == out.len(),
-            "a batch's rays, t_max and answers differ in length"
-        );
+        check_lengths(rays, t_max, out.len());
         Batch { rays, t_max, out, walk: PhantomData }
     }
+}
+
+/// Panics unless a batch's `rays`, `t_max` and `out_len` answers agree in length: every batch query
+/// checks it before any ray is traced.
+pub(super) fn check_lengths(rays: &[Ray], t_max: &[f32], out_len: usize) {
+    assert!(rays.len() == t_max.len() && rays.len() == out_len, "a batch's rays, t_max and answers differ in length");
 }
 
 impl<'a, W: Walker<'a>> Traversal for Batch<'a, W> {

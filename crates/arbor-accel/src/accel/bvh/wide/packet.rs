@@ -27,7 +27,7 @@
 
 use std::mem::MaybeUninit;
 
-use super::batch::{many, ClosestWalk};
+use super::batch::{check_lengths, many, ClosestWalk};
 use super::dispatch::{run_with, Traversal};
 use super::kernel::{lane_test, Kernel, Lanes, NodeTest};
 use super::leaves::{prepare, LeafRay, Leaves};
@@ -63,7 +63,7 @@ pub(in crate::accel::bvh) fn intersect_coherent_with<P: Primitives + ?Sized>(
     t_max: &[f32],
     out: &mut [Option<Hit>],
 ) {
-    assert!(rays.len() == t_max.len() && rays.len() == out.len(), "a batch's rays, t_max and answers differ in length");
+    check_lengths(rays, t_max, out.len());
     run_with(kernel, wide, indices, prims, Coherent { rays, t_max, out })
 }
 
