@@ -14,8 +14,9 @@ How instructions are attributed (inlining moves code between functions, so the r
 was written, which inlining keeps): traversal is every instruction of `arbor-accel`, of the scene's
 geometry queries (`scene/geometry.rs`) and of the ray log's query wrappers (`integrator/ray_log.rs`),
 and whatever is inlined into their functions (glam, std, SIMD intrinsics); camera rays are the inclusive cost of
-`RayLog::intersect_many` (the render loop's batched camera rays), shadow rays that of the ray log's lines
-inlined into the light sample (`direct`), bounce rays the rest of the traversal. Only the render loop is counted
+`RayLog::intersect_many` (the render loop's batched camera rays), shadow rays that of
+`RayLog::occluded_many` (the wavefront's batches; in a binary from before it, the ray log's lines inlined
+into the light sample, `direct`), bounce rays the rest of the traversal. Only the render loop is counted
 (`--toggle-collect` on `arbor::render::trace`'s closures): the structure's build and the image's output
 are outside it. Under valgrind the AVX2 kernels run (it has no AVX-512): instruction counts are AVX2's.
 Needs valgrind; takes seconds to minutes (a Cornell box's 262,144 samples: about 10 s).
@@ -85,8 +86,12 @@ def main():
     loop = sum(c for c, f, fn in excl)
     traversal = sum(c for c, f, fn in excl if in_traversal(f, fn))
     camera = one(incl, lambda f, fn: fn == "arbor::integrator::ray_log::RayLog::intersect_many", "camera rays")
-    shadow = one(incl, lambda f, fn: f.endswith("integrator/ray_log.rs") and fn.endswith("PathTracer>::direct"),
-                 "shadow rays (the ray log inlined into the light sample)")
+    # The wavefront's shadow rays go as one batch per step; a binary from before it traced each one from
+    # the light sample (`direct`), where the ray log's query was inlined.
+    batched = [c for c, f, fn in incl if fn == "arbor::integrator::ray_log::RayLog::occluded_many"]
+    shadow = max(batched) if batched else one(
+        incl, lambda f, fn: f.endswith("integrator/ray_log.rs") and fn.endswith("PathTracer>::direct"),
+        "shadow rays (the ray log's batch, or its query inlined into the light sample)")
     padded = sum(c for c, f, fn in incl if fn == "arbor::sampler::Padded::next_2d" and f.endswith("sampler.rs"))
     per = lambda n: f"{round(n / samples):,}"
     share = lambda n: f"{per(n)} ({100 * n / loop:.0f}%)"

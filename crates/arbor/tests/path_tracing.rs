@@ -303,3 +303,79 @@ fn path_unbiased_roulette_in_a_glowing_furnace_sums_every_bounce() {
     let want = le * (1.0 - kd.powi(depth as i32 + 1)) / (1.0 - kd);
     assert!(got.iter().all(|g| (g / want - 1.0).abs() < 1e-3), "{got:?} against {want}");
 }
+
+#[test]
+fn path_wavefront_gives_each_sample_the_one_path_loops_radiance_bit_for_bit() {
+    // The render steps a batch's paths together and traces their shadow and bounce rays in batches; a
+    // live view's inspector traces one sample alone. Both must give every sample the same radiance, to
+    // the bit, under every option: shadow-ray light summed in the same order, the course's roulette
+    // weighing a vertex's light only once its shadow rays are traced, branches of a split path after it.
+    // The scene has every kind of light a path meets or samples: a glowing box (emissive geometry),
+    // a point light, a glass sphere (split), a mirror with a diffuse colour (the mixture).
+    use arbor::integrator::{Integrator, RayLog};
+    use arbor::sampler::{SampleStream, Strata};
+    let xml = r#"<Scene><MaxRecursionDepth>5</MaxRecursionDepth><BackgroundColor>0 0 0</BackgroundColor>
+        <Cameras><Camera id="1"><Position>0 0 0.9</Position><Gaze>0 -0.5 -1</Gaze><Up>0 1 0</Up>
+        <NearPlane>-0.6 0.6 -0.6 0.6</NearPlane><NearDistance>1</NearDistance>
+        <ImageResolution>12 12</ImageResolution><ImageName>a.exr</ImageName></Camera></Cameras>
+        <Lights><PointLight id="1"><Position>0.3 0.8 0.2</Position><Intensity>0.6 0.5 0.4</Intensity></PointLight></Lights>
+        <Materials><Material id="1"><AmbientReflectance>0 0 0</AmbientReflectance>
+        <DiffuseReflectance>0.7 0.5 0.3</DiffuseReflectance><SpecularReflectance>0 0 0</SpecularReflectance></Material>
+        <Material id="2"><AmbientReflectance>0 0 0</AmbientReflectance><DiffuseReflectance>0.4 0.6 0.5</DiffuseReflectance>
+        <SpecularReflectance>0 0 0</SpecularReflectance></Material>
+        <Material id="3" type="dielectric"><AmbientReflectance>0 0 0</AmbientReflectance>
+        <DiffuseReflectance>0 0 0</DiffuseReflectance><SpecularReflectance>0 0 0</SpecularReflectance><AbsorptionCoefficient>0.3 0.2 0.1</AbsorptionCoefficient>
+        <RefractionIndex>1.5</RefractionIndex></Material>
+        <Material id="4" type="mirror"><AmbientReflectance>0 0 0</AmbientReflectance><DiffuseReflectance>0.3 0.3 0.3</DiffuseReflectance>
+        <SpecularReflectance>0 0 0</SpecularReflectance><MirrorReflectance>0.5 0.5 0.5</MirrorReflectance></Material></Materials>
+        <VertexData>-1 -1 -1  1 -1 -1  1 -1 1  -1 -1 1  -1 1 -1  1 1 -1  1 1 1  -1 1 1  -0.4 -0.6 -0.3  0.4 -0.6 -0.3</VertexData>
+        <Objects><Mesh id="1"><Material>1</Material><Faces>1 4 3  1 3 2</Faces></Mesh>
+        <LightMesh id="1"><Material>2</Material><Radiance>0.8 0.8 0.8</Radiance>
+        <Faces>5 6 7  5 7 8  1 5 8  1 8 4  2 3 7  2 7 6  1 2 6  1 6 5  4 8 7  4 7 3</Faces></LightMesh>
+        <Sphere id="1"><Material>3</Material><Center>9</Center><Radius>0.35</Radius></Sphere>
+        <Sphere id="2"><Material>4</Material><Center>10</Center><Radius>0.3</Radius></Sphere></Objects>
+        </Scene>"#;
+    let scene = build(xml, None);
+    let cam = &scene.cameras[0];
+    let (spp, seed) = (3, 7);
+    let strata = Strata::new(spp);
+    let mut options = Vec::new();
+    for bits in 0..48u32 {
+        let roulette = [Roulette::Off, Roulette::Course, Roulette::Unbiased][(bits / 16) as usize];
+        let (next_event, mis) = (bits & 2 != 0, bits & 4 != 0);
+        if mis && !next_event {
+            continue;
+        }
+        let (importance_sampling, split_refraction) = (bits & 1 != 0, bits & 8 != 0);
+        options.push(PathOptions { importance_sampling, next_event, roulette, mis, split_refraction });
+    }
+    for sampler in [SamplerKind::Stratified, SamplerKind::Independent] {
+        for &o in &options {
+            let integrator = Integrator::new(&scene, cam, Renderer::PathTracing(o), false);
+            let (mut rays, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
+            for (x, y, k) in (0..12).flat_map(|y| (0..12).flat_map(move |x| (0..spp).map(move |k| (x, y, k)))) {
+                let mut s = SampleStream::new(sampler, x, y, k, seed, strata);
+                let offset = strata.offset(k, &mut s.rng);
+                let ray = integrator.camera_ray(&cam.ray(x, y, offset, s.rng.next_2d()));
+                hits.push(scene.geometry.intersect(&ray, f32::INFINITY));
+                rays.push(ray);
+                streams.push(s);
+            }
+            let (mut log, mut batch) = (RayLog::default(), Vec::new());
+            let alone: Vec<Color> = (0..rays.len())
+                .map(|i| {
+                    let mut s = streams[i].clone();
+                    integrator.li_camera_hit(&rays[i], hits[i], &mut s, &mut log)
+                })
+                .collect();
+            let rays_alone = log.rays;
+            let mut log = RayLog::default();
+            integrator.li_camera_batch(&rays, &hits, &mut streams, &mut log, &mut batch);
+            let bits = |c: &Color| c.to_array().map(f32::to_bits);
+            let differ = alone.iter().zip(&batch).filter(|(a, b)| bits(a) != bits(b)).count();
+            assert_eq!(differ, 0, "{sampler:?} {o:?}: {differ} of {} samples differ", rays.len());
+            assert_eq!(log.rays, rays_alone, "{sampler:?} {o:?}: rays counted");
+            assert!(alone.iter().any(|c| c.max_element() > 0.0), "{o:?}: a black image tests nothing");
+        }
+    }
+}

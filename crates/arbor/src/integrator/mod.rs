@@ -58,4 +58,26 @@ impl<'a> Integrator<'a> {
             Integrator::Path(p) => p.li_camera_hit(ray, hit, sample, log),
         }
     }
+
+    /// [`Integrator::li_camera_hit`] of each camera ray of a batch (`rays[i]`, `hits[i]`,
+    /// `streams[i]`) into `out[i]`: the same values; the path tracer steps the batch's paths together
+    /// (its wavefront), Whitted's integrator takes them one by one.
+    pub fn li_camera_batch(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        streams: &mut [SampleStream],
+        log: &mut RayLog,
+        out: &mut Vec<Color>,
+    ) {
+        match self {
+            Integrator::Path(p) => p.li_camera_batch(rays, hits, streams, log, out),
+            Integrator::Whitted(_) => {
+                out.clear();
+                for ((r, h), s) in rays.iter().zip(hits).zip(streams) {
+                    out.push(self.li_camera_hit(r, *h, s, log));
+                }
+            }
+        }
+    }
 }

@@ -106,6 +106,21 @@ impl RayLog {
         self.batches += thread_time().saturating_sub(start);
     }
 
+    /// [`SceneGeometry::intersect_scattered`] for a batch of secondary rays, timed as
+    /// [`RayLog::intersect_many`]; not counted.
+    pub fn intersect_scattered(&mut self, g: &SceneGeometry, rays: &[Ray], out: &mut [Option<Hit>]) {
+        let start = thread_time();
+        g.intersect_scattered(rays, out);
+        self.batches += thread_time().saturating_sub(start);
+    }
+
+    /// [`SceneGeometry::occluded_many`], timed as [`RayLog::intersect_many`]; not counted.
+    pub fn occluded_many(&mut self, g: &SceneGeometry, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
+        let start = thread_time();
+        g.occluded_many(rays, t_max, out);
+        self.batches += thread_time().saturating_sub(start);
+    }
+
     #[inline(always)]
     fn query<T>(&mut self, f: impl FnOnce() -> T) -> T {
         self.queries += 1;

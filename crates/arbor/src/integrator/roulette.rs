@@ -36,13 +36,25 @@ pub const MAX_BOUNCES: u32 = 256;
 /// is divided, or `None`. A certain survival (`q = 1`, the camera's first hit) draws no number.
 #[inline]
 pub fn course(t: Color, e: Color, l: &mut Color, sample: &mut SampleStream) -> Option<f32> {
+    let (q, survives) = course_draw(t, sample);
+    course_keep(e, q, survives, l);
+    survives.then_some(q)
+}
+
+/// The course's roulette's choice at a vertex of BRDF product `t`: its survival probability `q` and
+/// whether the path survives. Drawn apart from [`course_keep`] where the vertex's own light is known
+/// only later (the wavefront's shadow rays are traced after the step).
+#[inline]
+pub fn course_draw(t: Color, sample: &mut SampleStream) -> (f32, bool) {
     let q = t.max_element().min(1.0);
-    if q < 1.0 && sample.rng.next_f32() >= q {
-        *l += e;
-        return None;
-    }
-    *l += e / q;
-    Some(q)
+    (q, q >= 1.0 || sample.rng.next_f32() < q)
+}
+
+/// What a vertex of the course's roulette keeps of its own light `e`, added to `l`: `e / q` when the
+/// path survives, `e` when it ends.
+#[inline]
+pub fn course_keep(e: Color, q: f32, survives: bool, l: &mut Color) {
+    *l += if survives { e / q } else { e };
 }
 
 /// The unbiased roulette after a bounce that left the path with throughput `beta`: the probability `q`

@@ -269,7 +269,7 @@ fn trace(
             // The camera rays of a few pixels are traced as one batch, then shaded pixel by pixel.
             let samples = (k1 - k0) as usize;
             let per_batch = (BATCH / samples).max(1);
-            let (mut batch, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut batch, mut streams, mut hits, mut radiance) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
             for group in tile.chunks(per_batch) {
                 batch.clear();
                 streams.clear();
@@ -283,20 +283,22 @@ fn trace(
                         streams.push(sample);
                     }
                 }
-                if debug.is_none() {
-                    hits.resize(batch.len(), None);
-                    log.intersect_many(&scene.geometry, &batch, f32::INFINITY, &mut hits);
+                radiance.clear();
+                match &debug {
+                    Some(d) => radiance.extend(batch.iter().map(|r| {
+                        log.rays += 1;
+                        d.li_camera(r)
+                    })),
+                    None => {
+                        hits.resize(batch.len(), None);
+                        log.intersect_many(&scene.geometry, &batch, f32::INFINITY, &mut hits);
+                        integrator.li_camera_batch(&batch, &hits, &mut streams, &mut log, &mut radiance);
+                    }
                 }
-                for p in 0..group.len() {
+                for pixel in radiance.chunks(samples) {
                     let mut sum = SampleSum::default();
-                    for s in p * samples..(p + 1) * samples {
-                        sum.add_sample(match &debug {
-                            Some(d) => {
-                                log.rays += 1;
-                                d.li_camera(&batch[s])
-                            }
-                            None => integrator.li_camera_hit(&batch[s], hits[s], &mut streams[s], &mut log),
-                        });
+                    for &c in pixel {
+                        sum.add_sample(c);
                     }
                     pixels.push(sum);
                 }

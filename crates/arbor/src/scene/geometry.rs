@@ -282,6 +282,51 @@ impl SceneGeometry {
         }
     }
 
+    /// [`SceneGeometry::intersect`] in `(0, inf)` for a batch of rays that go every way (a path
+    /// tracer's bounces): `out[i]` becomes `rays[i]`'s hit, the same hit as its own query. The top level
+    /// takes the whole batch ([`Accel::intersect_many`]: the BVH walks two rays at once, which hides
+    /// the latency of one behind the other's).
+    ///
+    /// # Panics
+    /// When `rays` and `out` differ in length.
+    pub fn intersect_scattered(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "a batch's rays and hits differ in length");
+        // An invalid ray (a NaN) is never handed to a structure, as in `intersect`.
+        if !rays.iter().all(Ray::is_valid) {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = self.intersect(r, f32::INFINITY);
+            }
+            return;
+        }
+        let t_max = vec![f32::INFINITY; rays.len()];
+        self.top.intersect_many(&self.objects, rays, &t_max, out);
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.intersect_planes(r, f32::INFINITY, *o, None);
+        }
+    }
+
+    /// [`SceneGeometry::occluded`] for a batch: `out[i]` becomes whether anything lies on `rays[i]` in
+    /// `(0, t_max[i])`, through the top level's batched query.
+    ///
+    /// # Panics
+    /// When `rays`, `t_max` and `out` differ in length.
+    pub fn occluded_many(&self, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
+        assert!(
+            rays.len() == t_max.len() && rays.len() == out.len(),
+            "a batch's rays, t_max and answers differ in length"
+        );
+        if !rays.iter().all(Ray::is_valid) {
+            for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
+                *o = self.occluded(r, t);
+            }
+            return;
+        }
+        self.top.occluded_many(&self.objects, rays, t_max, out);
+        for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
+            *o = *o || self.planes.iter().any(|p| p.intersect(r, t).is_some());
+        }
+    }
+
     /// Whether [`SceneGeometry::intersect_many`] sweeps the objects: one, or a few large ones
     /// ([`SWEEP_OBJECTS`]).
     pub fn sweeps(&self) -> bool {

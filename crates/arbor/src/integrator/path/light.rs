@@ -5,10 +5,12 @@
 
 use super::PathTracer;
 use crate::integrator::offset::shadow_ray;
+use crate::integrator::roulette;
 use crate::integrator::RayLog;
 use crate::material::Brdf;
-use crate::math::{Color, Vec2, Vec3};
-use crate::scene::Surface;
+use crate::math::{Color, Ray, Vec2, Vec3};
+use crate::sampler::SampleStream;
+use crate::scene::{SceneGeometry, Surface};
 
 impl PathTracer<'_> {
     /// A light chosen in proportion to its power by `u` in [0, 1), and the probability of that choice.
@@ -43,9 +45,10 @@ impl PathTracer<'_> {
     }
 
     /// Adds to `l` the light `i` brings to the vertex `at` of throughput `beta` through one sample `u` of
-    /// it, a shadow ray from `origin`, when it was chosen with probability `chosen`; nothing when the
-    /// sample is below the surface or blocked. Added here rather than returned: an `Option<Color>`
-    /// comes back through memory, and the caller's wider load of it stalled on the narrower stores.
+    /// it, a shadow ray from `origin` (traced by `shadows`), when it was chosen with probability
+    /// `chosen`; nothing when the sample is below the surface or blocked. Added rather than returned:
+    /// an `Option<Color>` comes back through memory, and the caller's wider load of it stalled on the
+    /// narrower stores.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(super) fn direct(
@@ -58,6 +61,7 @@ impl PathTracer<'_> {
         chosen: f32,
         log: &mut RayLog,
         l: &mut Color,
+        shadows: &mut impl Shadows,
     ) {
         let scene = self.scene;
         let (s, ns) = (at.s, at.ns);
@@ -65,16 +69,20 @@ impl PathTracer<'_> {
         let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
         log.rays += 1;
         let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, self.on_surface[i]);
-        if log.occluded(&scene.geometry, &shadow.with_time(at.time), t_max) {
-            return;
-        }
         let w = if self.options.mis && ls.pdf > 0.0 {
             power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
         } else {
             1.0
         };
         let f = at.f(ls.wi) * ns.dot(ls.wi);
-        *l += beta * f * ls.irradiance * (w / chosen);
+        shadows.cast(
+            &scene.geometry,
+            log,
+            &shadow.with_time(at.time),
+            t_max,
+            beta * f * ls.irradiance * (w / chosen),
+            l,
+        );
     }
 
     /// The density of a bounce direction `wi` about the shading normal `n`.
@@ -85,6 +93,37 @@ impl PathTracer<'_> {
             _ if self.options.importance_sampling => cos / std::f32::consts::PI,
             _ => 1.0 / (2.0 * std::f32::consts::PI),
         }
+    }
+}
+
+/// Where a vertex's shadow rays are traced: at once ([`Now`]), or with the other paths' of a step
+/// (the wavefront). Either way a vertex's light is summed in the order the one-path loop sums it.
+pub(super) trait Shadows {
+    /// Light `c` that reaches a vertex unless something lies on `ray` in `(0, t_max)`: added to `own`
+    /// (the path's light, or under the course's roulette the vertex's) once the ray is traced.
+    fn cast(&mut self, g: &SceneGeometry, log: &mut RayLog, ray: &Ray, t_max: f32, c: Color, own: &mut Color);
+
+    /// The course's roulette at a vertex of BRDF product `t` ([`roulette::course`]), whose own light
+    /// `e` may still be waiting on its shadow rays: `q` when the path goes on.
+    fn course(&mut self, t: Color, e: &mut Color, l: &mut Color, sample: &mut SampleStream) -> Option<f32>;
+}
+
+/// Shadow rays traced when they are cast: one path at a time.
+pub(super) struct Now;
+
+impl Shadows for Now {
+    #[inline(always)]
+    fn cast(&mut self, g: &SceneGeometry, log: &mut RayLog, ray: &Ray, t_max: f32, c: Color, own: &mut Color) {
+        if !log.occluded(g, ray, t_max) {
+            *own += c;
+        }
+    }
+
+    #[inline(always)]
+    fn course(&mut self, t: Color, e: &mut Color, l: &mut Color, sample: &mut SampleStream) -> Option<f32> {
+        let q = roulette::course(t, *e, l, sample);
+        *e = Color::ZERO;
+        q
     }
 }
 

@@ -27,11 +27,15 @@
 //! tests check it; the course's roulette's test checks its `Σ (2 - q_k) E_k`); a sample's value depends
 //! only on its random stream.
 //!
-//! Layout: [`PathTracer::li_camera_hit`] drives a path, tracing each ray; `vertex` takes one hit and
-//! does the rest of a step (emission, light samples through [`light`], the roulettes, the next direction
-//! or the split's branches), with what the path carries between steps in a `PathState`.
+//! Layout: `vertex` takes one hit and does the rest of a step (emission, light samples through
+//! [`light`], the roulettes, the next direction or the split's branches), with what the path carries
+//! between steps in a `PathState`. Two drivers call it: the render's [`PathTracer::li_camera_batch`]
+//! steps a batch's paths together and traces their rays in batches ([`wavefront`]), and
+//! [`PathTracer::li_camera_hit`] one path alone, each ray as it comes (a live view's ray inspector,
+//! which records every query in order); both give a sample the same radiance, bit for bit.
 
 mod light;
+mod wavefront;
 
 use super::hemisphere::{cosine_hemisphere, uniform_hemisphere};
 use super::offset::spawn_origin;
@@ -45,7 +49,7 @@ use crate::math::{Color, Ray, Vec3};
 use crate::renderer::{PathOptions, Roulette};
 use crate::sampler::SampleStream;
 use crate::scene::Scene;
-use light::Vertex;
+use light::{Now, Shadows, Vertex};
 
 /// The path tracer for one render.
 pub struct PathTracer<'a> {
@@ -107,18 +111,19 @@ impl<'a> PathTracer<'a> {
         log.rays += 1;
         let mut l = Color::ZERO;
         let (mut ray, mut hit) = (*ray, hit);
-        let mut p = PathState { beta: Color::ONE, inside: None, last: None, t: Color::ONE, bounce: 0 };
+        let mut p = PathState::camera();
         // Paths split at refractive surfaces ([`super::split`]) leave branches here.
         let mut branches = Branches::default();
         loop {
-            while let Some((origin, dir)) = self.vertex(&ray, hit, &mut p, &mut l, &mut branches, sample, log) {
+            while let Some((origin, dir)) = self.vertex(&ray, hit, &mut p, &mut l, &mut branches, sample, log, &mut Now)
+            {
                 ray = Ray::new(origin, dir).with_time(ray.time);
                 log.rays += 1;
                 hit = log.intersect(&self.scene.geometry, &ray, f32::INFINITY);
             }
             let Some(b) = self.next_branch(&mut branches, sample) else { break };
             ray = b.ray;
-            p = PathState { beta: b.beta, inside: b.inside, last: None, t: b.t, bounce: b.bounce };
+            p = PathState::branch(&b, p.e);
             log.rays += 1;
             hit = log.intersect(&self.scene.geometry, &ray, f32::INFINITY);
         }
@@ -128,7 +133,8 @@ impl<'a> PathTracer<'a> {
     /// One vertex of the path `p`, where its ray `ray` met `hit` (or nothing): adds the light it gathers
     /// there to `l`, leaves the other lobes of a split in `branches`, advances `p` and returns the origin
     /// and direction of the ray it goes on with, untraced; `None` when the path (or this branch) ends.
-    /// The ray is built and traced by the caller: returned whole, it went through memory.
+    /// The ray is built and traced by the caller: returned whole, it went through memory. Shadow rays
+    /// go to `shadows`, which traces them at once or with the step's others.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn vertex(
@@ -140,6 +146,7 @@ impl<'a> PathTracer<'a> {
         branches: &mut Branches,
         sample: &mut SampleStream,
         log: &mut RayLog,
+        shadows: &mut impl Shadows,
     ) -> Option<(Vec3, Vec3)> {
         let scene = self.scene;
         let o = self.options;
@@ -157,10 +164,9 @@ impl<'a> PathTracer<'a> {
         }
         let mut s = scene.surface(ray, &h);
         let m = scene.material(&s);
-        // The vertex's own light goes to `l`, or under the course's roulette to `e` first, which the
+        // The vertex's own light goes to `l`, or under the course's roulette to `p.e` first, which the
         // roulette then weighs.
-        let mut e = Color::ZERO;
-        let own = if course { &mut e } else { &mut *l };
+        let own = if course { &mut p.e } else { &mut *l };
         let emitted = scene.emitted(&s, -ray.dir);
         if emitted != Color::ZERO {
             let w = p.last.map_or(1.0, |(from, pdf)| {
@@ -174,7 +180,7 @@ impl<'a> PathTracer<'a> {
         if let Some(c) = textured.and_then(|t| t.replace_all) {
             *own += p.beta * c;
             if course {
-                roulette::course(p.t, e, l, sample);
+                shadows.course(p.t, &mut p.e, l, sample);
             }
             return None;
         }
@@ -230,15 +236,15 @@ impl<'a> PathTracer<'a> {
                     // A delta light's numbers are never read: plain ones, not a padded dimension
                     // (the independent sampler draws the same numbers either way).
                     let u = if sampled { sample.padded_2d() } else { sample.rng.next_2d() };
-                    self.direct(&at, p.beta, origin, i, u, 1.0, log, own);
+                    self.direct(&at, p.beta, origin, i, u, 1.0, log, own, shadows);
                 }
                 if let Some((i, chosen)) = self.choose_light(pick) {
-                    self.direct(&at, p.beta, origin, i, u, chosen, log, own);
+                    self.direct(&at, p.beta, origin, i, u, chosen, log, own, shadows);
                 }
             }
         }
         if course {
-            let q = roulette::course(p.t, e, l, sample)?;
+            let q = shadows.course(p.t, &mut p.e, l, sample)?;
             p.beta /= q;
         }
 
@@ -344,6 +350,9 @@ fn path_brdf(m: &Material) -> Brdf {
 
 /// What a path carries from one vertex to the next.
 struct PathState {
+    /// Under the course's roulette, the light of the vertex being shaded, until the roulette weighs it
+    /// (zero between vertices, but while its shadow rays wait to be traced).
+    e: Color,
     beta: Color,
     /// The absorption of the medium the ray travels in (inside a dielectric), if any.
     inside: Option<Color>,
@@ -353,6 +362,19 @@ struct PathState {
     /// The course's roulette's throughput: the product of the BRDF values met so far.
     t: Color,
     bounce: u32,
+}
+
+impl PathState {
+    /// The state of a camera ray's path.
+    fn camera() -> PathState {
+        PathState { e: Color::ZERO, beta: Color::ONE, inside: None, last: None, t: Color::ONE, bounce: 0 }
+    }
+
+    /// The state of a branch of a split path, which takes over the light `e` still waiting for the
+    /// roulette of the vertex that made it.
+    fn branch(b: &Branch, e: Color) -> PathState {
+        PathState { e, beta: b.beta, inside: b.inside, last: None, t: b.t, bounce: b.bounce }
+    }
 }
 
 fn luminance(c: Color) -> f32 {
