@@ -69,6 +69,8 @@ impl PathTracer<'_> {
         let Some(ls) = light.sample(s.p, ns, u).filter(|ls| ns.dot(ls.wi) > 0.0) else { return };
         log.rays += 1;
         let (shadow, t_max) = shadow_ray(scene.offset, origin, s.p, &ls, self.on_surface[i]);
+        // The light is worked out before the shadow ray is traced: the wavefront traces it later, with
+        // the step's others, when this vertex's surface is gone.
         let w = if self.options.mis && ls.pdf > 0.0 {
             power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
         } else {
