@@ -101,23 +101,24 @@ impl RayLog {
     /// [`SceneGeometry::intersect_many`], always timed on the thread's CPU clock (a batch is worth
     /// many clock reads); not counted.
     pub fn intersect_many(&mut self, g: &SceneGeometry, rays: &[Ray], t_max: f32, out: &mut [Option<Hit>]) {
-        let start = thread_time();
-        g.intersect_many(rays, t_max, out);
-        self.batches += thread_time().saturating_sub(start);
+        self.batch(|| g.intersect_many(rays, t_max, out));
     }
 
     /// [`SceneGeometry::intersect_scattered`] for a batch of secondary rays, timed as
     /// [`RayLog::intersect_many`]; not counted.
     pub fn intersect_scattered(&mut self, g: &SceneGeometry, rays: &[Ray], out: &mut [Option<Hit>]) {
-        let start = thread_time();
-        g.intersect_scattered(rays, out);
-        self.batches += thread_time().saturating_sub(start);
+        self.batch(|| g.intersect_scattered(rays, out));
     }
 
     /// [`SceneGeometry::occluded_many`], timed as [`RayLog::intersect_many`]; not counted.
     pub fn occluded_many(&mut self, g: &SceneGeometry, rays: &[Ray], t_max: &[f32], out: &mut [bool]) {
+        self.batch(|| g.occluded_many(rays, t_max, out));
+    }
+
+    /// Runs the batch query `f`, timed on the thread's CPU clock into the batches' time.
+    fn batch(&mut self, f: impl FnOnce()) {
         let start = thread_time();
-        g.occluded_many(rays, t_max, out);
+        f();
         self.batches += thread_time().saturating_sub(start);
     }
 

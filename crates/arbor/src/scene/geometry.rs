@@ -323,7 +323,7 @@ impl SceneGeometry {
         }
         self.top.occluded_many(&self.objects, rays, t_max, out);
         for ((o, r), &t) in out.iter_mut().zip(rays).zip(t_max) {
-            *o = *o || self.planes.iter().any(|p| p.intersect(r, t).is_some());
+            *o = *o || self.plane_blocks(r, t);
         }
     }
 
@@ -366,9 +366,12 @@ impl SceneGeometry {
     /// Whether anything lies on `ray` in `(0, t_max)`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        ray.is_valid()
-            && (self.planes.iter().any(|p| p.intersect(ray, t_max).is_some())
-                || self.top.occluded(&self.objects, ray, t_max))
+        ray.is_valid() && (self.plane_blocks(ray, t_max) || self.top.occluded(&self.objects, ray, t_max))
+    }
+
+    /// Whether an infinite plane lies on `ray` in `(0, t_max)`.
+    fn plane_blocks(&self, ray: &Ray, t_max: f32) -> bool {
+        self.planes.iter().any(|p| p.intersect(ray, t_max).is_some())
     }
 
     /// A scene-wide id of the primitive hit (triangle, sphere or plane), the same for every structure.
