@@ -28,8 +28,10 @@ pub struct IntegratorArgs {
     #[arg(long, value_enum)]
     pub roulette: Option<RouletteArg>,
     /// The path tracer's samples: stratified (each light and bounce sample spread over the pixel's
-    /// samples, in its own random order: less noise for the same samples), or independent (each at
-    /// random, as Arbor drew them before). The other integrators are the same with either.
+    /// samples, in its own random order: less noise for the same samples), independent (each at
+    /// random, as Arbor drew them before), or sobol (spread as stratified, each a point of an
+    /// Owen-scrambled Sobol sequence: less noise again). The other integrators are the same with
+    /// stratified or independent; sobol also places their samples in the pixel.
     #[arg(long, value_enum, default_value_t = SamplerArg::Stratified)]
     pub sampler: SamplerArg,
 }
@@ -41,6 +43,10 @@ pub enum SamplerArg {
     Stratified,
     /// Only the sample positions in the pixel are stratified.
     Independent,
+    /// As stratified, but every 2D value (the position in the pixel too) is a point of an
+    /// Owen-scrambled Sobol sequence instead of a jittered cell: less noise again where the light
+    /// varies smoothly, most at powers of two samples.
+    Sobol,
 }
 
 impl From<SamplerArg> for SamplerKind {
@@ -48,6 +54,7 @@ impl From<SamplerArg> for SamplerKind {
         match s {
             SamplerArg::Stratified => SamplerKind::Stratified,
             SamplerArg::Independent => SamplerKind::Independent,
+            SamplerArg::Sobol => SamplerKind::Sobol,
         }
     }
 }

@@ -188,7 +188,8 @@ mod tests {
         assert_ne!(a, identity(b"scene", "1", 4, Some(Path::new("sky.exr")), &base));
         // Streams of another version are another render.
         assert_eq!(sampler_name(SamplerKind::Independent), None);
-        assert_eq!(sampler_name(SamplerKind::Stratified).as_deref(), Some("Stratified/2"));
+        assert_eq!(sampler_name(SamplerKind::Stratified).as_deref(), Some("Stratified/3"));
+        assert_eq!(sampler_name(SamplerKind::Sobol).as_deref(), Some("Sobol/1"));
         // What differs between one render's slices does not change it.
         let slice = RenderOptions { crop: Some((0, 0, 8, 8)), samples: Some((0, 2)), ..base.clone() };
         assert_eq!(a, identity(b"scene", "1", 4, None, &slice));

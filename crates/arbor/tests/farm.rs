@@ -86,6 +86,7 @@ fn farm_path_tracer_sample_ranges_merge_to_the_whole() {
     for (sampler, roulette) in [
         (SamplerKind::Stratified, Roulette::Off),
         (SamplerKind::Independent, Roulette::Off),
+        (SamplerKind::Sobol, Roulette::Off),
         (SamplerKind::Stratified, Roulette::Course),
     ] {
         let split_refraction = roulette == Roulette::Course;

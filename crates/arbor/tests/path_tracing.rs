@@ -211,6 +211,8 @@ fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
         };
         let (mean_i, var_i) = noise(SamplerKind::Independent);
         let (mean_s, var_s) = noise(SamplerKind::Stratified);
+        let (mean_o, var_o) = noise(SamplerKind::Sobol);
+        eprintln!("{what}: variance independent {var_i} stratified {var_s} sobol {var_o}; means {mean_i} {mean_s} {mean_o}");
         assert!(var_i > 0.0 && mean_i > 0.01, "{what}: the image has light and noise: {mean_i} {var_i}");
         assert!(var_s < 0.8 * var_i, "{what}: stratified variance {var_s} against independent {var_i}");
         assert!((mean_s - mean_i).abs() < 0.02 * mean_i, "{what}: means {mean_s} and {mean_i}");
@@ -349,13 +351,13 @@ fn path_wavefront_gives_each_sample_the_one_path_loops_radiance_bit_for_bit() {
         let (importance_sampling, split_refraction) = (bits & 1 != 0, bits & 8 != 0);
         options.push(PathOptions { importance_sampling, next_event, roulette, mis, split_refraction });
     }
-    for sampler in [SamplerKind::Stratified, SamplerKind::Independent] {
+    for sampler in [SamplerKind::Stratified, SamplerKind::Independent, SamplerKind::Sobol] {
         for &o in &options {
             let integrator = Integrator::new(&scene, cam, Renderer::PathTracing(o), false);
             let (mut rays, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
             for (x, y, k) in (0..12).flat_map(|y| (0..12).flat_map(move |x| (0..spp).map(move |k| (x, y, k)))) {
                 let mut s = SampleStream::new(sampler, x, y, k, seed, strata);
-                let offset = strata.offset(k, &mut s.rng);
+                let offset = s.pixel_offset(strata, k);
                 let ray = integrator.camera_ray(&cam.ray(x, y, offset, s.rng.next_2d()));
                 hits.push(scene.geometry.intersect(&ray, f32::INFINITY));
                 rays.push(ray);

@@ -20,7 +20,7 @@ pub(super) fn camera_sample(
     (x, y, k): (u32, u32, u32),
 ) -> (Ray, SampleStream) {
     let mut sample = SampleStream::new(opts.sampler, x, y, k, opts.seed, strata);
-    let offset = strata.offset(k, &mut sample.rng);
+    let offset = sample.pixel_offset(strata, k);
     let ray = cam.ray(x, y, offset, sample.rng.next_2d());
     // A time is drawn only when something moves, so still scenes keep their streams.
     let ray = if moving { ray.with_time(sample.rng.next_f32()) } else { ray };
