@@ -167,7 +167,7 @@ fn path_variance_of_a_pixel_mean_falls_as_one_over_the_samples() {
 }
 
 #[test]
-fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
+fn path_stratified_and_sobol_samplers_keep_the_mean_and_lower_the_noise() {
     // Two scenes where one kind of sample is the only random number of a vertex: the scene of the test
     // above with uniform bounces (the point light needs no sample), and a square area light with no
     // bounce at all (its light samples, drawn at every vertex, are all the noise).
@@ -212,10 +212,12 @@ fn path_stratified_sampler_keeps_the_mean_and_lowers_the_noise() {
         let (mean_i, var_i) = noise(SamplerKind::Independent);
         let (mean_s, var_s) = noise(SamplerKind::Stratified);
         let (mean_o, var_o) = noise(SamplerKind::Sobol);
-        eprintln!("{what}: variance independent {var_i} stratified {var_s} sobol {var_o}; means {mean_i} {mean_s} {mean_o}");
         assert!(var_i > 0.0 && mean_i > 0.01, "{what}: the image has light and noise: {mean_i} {var_i}");
         assert!(var_s < 0.8 * var_i, "{what}: stratified variance {var_s} against independent {var_i}");
         assert!((mean_s - mean_i).abs() < 0.02 * mean_i, "{what}: means {mean_s} and {mean_i}");
+        // Measured: 0.74x, 0.70x and 0.98x the stratified sampler's variance.
+        assert!(var_o < 0.8 * var_i, "{what}: sobol variance {var_o} against independent {var_i}");
+        assert!((mean_o - mean_i).abs() < 0.02 * mean_i, "{what}: means {mean_o} and {mean_i}");
     }
 }
 
