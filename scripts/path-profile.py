@@ -92,7 +92,7 @@ def main():
     shadow = max(batched) if batched else one(
         incl, lambda f, fn: f.endswith("integrator/ray_log.rs") and fn.endswith("PathTracer>::direct"),
         "shadow rays (the ray log's batch, or its query inlined into the light sample)")
-    padded = sum(c for c, f, fn in incl if fn == "arbor::sampler::Padded::next_2d" and f.endswith("sampler.rs"))
+    padded = sum(c for c, f, fn in incl if fn == "arbor::sampler::Padded::next_2d" and f.endswith(("sampler.rs", "sampler/mod.rs")))
     per = lambda n: f"{round(n / samples):,}"
     share = lambda n: f"{per(n)} ({100 * n / loop:.0f}%)"
     print(f"| {a.name} | {per(loop)} | {per(camera)} | {per(traversal - camera - shadow)} | {per(shadow)} "
