@@ -113,7 +113,8 @@ mod tests {
                 for start in [0, n, 5 * n] {
                     let pts: Vec<[f32; 2]> = (start..start + n).map(|i| point_2d(i, seed)).collect();
                     assert!(is_net(&pts), "m {m} seed {seed:x} start {start}");
-                    let mut xs: Vec<u32> = (start..start + n).map(|i| (point_1d(i, seed as u32) * n as f32) as u32).collect();
+                    let mut xs: Vec<u32> =
+                        (start..start + n).map(|i| (point_1d(i, seed as u32) * n as f32) as u32).collect();
                     xs.sort_unstable();
                     assert_eq!(xs, (0..n).collect::<Vec<_>>(), "1D, m {m}");
                 }
