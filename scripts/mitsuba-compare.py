@@ -25,7 +25,9 @@ libllvm19`; LIBLLVM below is used when DRJIT_LIBLLVM_PATH is unset and the file 
 What is translated: materials with SpecularReflectance 0 (any BRDF, or none) become Mitsuba `diffuse`
 with reflectance DiffuseReflectance; `dielectric` becomes `dielectric` (RefractionIndex; an
 AbsorptionCoefficient is dropped with a note); `mirror` becomes a `conductor` with
-specular_reflectance MirrorReflectance. A `LightMesh`/`LightSphere` Radiance is a Mitsuba `area`
+specular_reflectance MirrorReflectance. A dielectric's or mirror's SpecularReflectance (a Phong lobe
+beside the delta lobes, which neither Mitsuba BSDF has) is dropped with a note for both renderers:
+Arbor renders a copy of the scene without it (in --cache). A `LightMesh`/`LightSphere` Radiance is a Mitsuba `area`
 emitter (one-sided, on the side the triangle winding faces), a `PointLight` a `point` emitter.
 MaxRecursionDepth D is Mitsuba max_depth D + 2 unless --max-depth is given (it changes Mitsuba only):
 Mitsuba counts the camera ray as segment 1, the course's renderers recurse D times after the primary
@@ -431,6 +433,30 @@ def mean_relative_difference(a, b, block=1):
 # The comparison
 
 
+def arbor_scene(path, cache):
+    """The scene Arbor renders: `path` itself, or, where a `dielectric` or `mirror` material also has a
+    SpecularReflectance (a Phong lobe, which Mitsuba's `dielectric` and `conductor` have no counterpart
+    for and the translation drops), a copy in `cache` without that lobe, so that both renderers render
+    the same scene (the hw6 glass has one: SpecularReflectance 0.3). ([path], notes)."""
+    tree = ET.parse(path)
+    dropped = [m for m in tree.getroot().findall("Materials/Material")
+               if (m.get("type") or "").strip() in ("dielectric", "mirror")
+               and any(child_floats(m, "SpecularReflectance", [0.0]))]
+    if not dropped:
+        return path, []
+    for m in dropped:
+        m.find("SpecularReflectance").text = "0 0 0"
+    # The copy lives elsewhere: files it names are given by their full paths.
+    for el in tree.getroot().iter():
+        if el.get("plyFile"):
+            el.set("plyFile", str((Path(path).parent / el.get("plyFile").strip()).resolve()))
+    copy = Path(cache) / f"{Path(path).stem}_without_lobes.xml"
+    tree.write(copy)
+    ids = ", ".join(m.get("id") for m in dropped)
+    return copy, [f"material {ids}: its SpecularReflectance (a Phong lobe beside the specular "
+                  f"surface) dropped on both sides: Mitsuba has no counterpart, Arbor renders {copy.name}"]
+
+
 def references(args, path, camera_id, tag, arbor_ok):
     """High-spp images {renderer: image or None}, rendered once and cached in --cache."""
     refs = {}
@@ -446,8 +472,8 @@ def references(args, path, camera_id, tag, arbor_ok):
     refs["Arbor"] = None
     if arbor_ok and not arbor_file.exists():
         print(f"  rendering the Arbor reference ({args.ref_spp} spp) ...", flush=True)
-        render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options, path, camera_id, args.ref_spp,
-                     max(args.threads), arbor_file, seed=1)
+        render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options, args.arbor_path, camera_id,
+                     args.ref_spp, max(args.threads), arbor_file, seed=1)
     if arbor_ok and arbor_file.exists():
         refs["Arbor"] = read_exr(arbor_file)
     return refs
@@ -471,10 +497,11 @@ def compare_scene(args, spec, arbor_ok):
     except Unsupported as e:
         print(f"  skipped: {e}")
         return []
-    for note in notes:
+    args.arbor_path, dropped = arbor_scene(path, args.cache)
+    for note in notes + dropped:
         print(f"  note: {note}")
     camera_id = cam["id"]
-    tag = f"{path.stem}_cam{camera_id}_d{depth}{'_rr' if args.roulette else ''}"
+    tag = f"{path.stem}_cam{camera_id}_d{depth}{'_rr' if args.roulette else ''}{'_nolobes' if dropped else ''}"
     roulette = ", Russian roulette (Arbor's unbiased one, Mitsuba's)" if args.roulette else ""
     print(f"  camera {camera_id}, {cam['width']}x{cam['height']}, Mitsuba max_depth {depth}{roulette}", flush=True)
     refs = references(args, path, camera_id, tag, arbor_ok)
@@ -496,7 +523,8 @@ def compare_scene(args, spec, arbor_ok):
         out = args.cache / f"{tag}_arbor_run.exr"
         name = "Arbor" if args.arbor_sampler is None else f"Arbor ({args.arbor_sampler})"
         renderers.append((name, lambda t: render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options,
-                                                       path, camera_id, args.spp, t, out, sampler=args.arbor_sampler)))
+                                                       args.arbor_path, camera_id, args.spp, t, out,
+                                                       sampler=args.arbor_sampler)))
     for name, render in renderers:
         for threads in args.threads:
             result = render(threads)
