@@ -37,7 +37,7 @@ impl Rng {
     /// A float uniform in `[0, 1)`.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        unit_float(self.next_u32())
     }
 
     /// Two floats uniform in `[0, 1)`.
@@ -45,6 +45,13 @@ impl Rng {
     pub fn next_2d(&mut self) -> Vec2 {
         Vec2::new(self.next_f32(), self.next_f32())
     }
+}
+
+/// 32 random bits (or a 32-bit binary fraction) as a float in `[0, 1)`: the top 24 bits, exact, never
+/// rounded up to 1.
+#[inline]
+fn unit_float(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// Pixel `(x, y)` as one 64-bit word, the input of the per-pixel hashes.

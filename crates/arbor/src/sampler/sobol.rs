@@ -11,6 +11,8 @@
 //! per number (four lookups in a 4 KiB table and two hashes per 2D point) on the path tracer's every
 //! vertex, where a general low-discrepancy crate's tables and dispatch would cost more than the point.
 
+use super::unit_float;
+
 /// Sobol's direction numbers of his second dimension (primitive polynomial `x + 1`): `v_0 = 2^31`,
 /// `v_i = v_(i-1) ^ (v_(i-1) >> 1)`. His first dimension is the bit reversal of the index (van der Corput).
 const DIRECTIONS: [u32; 32] = {
@@ -53,17 +55,23 @@ static BYTES: [[u32; 256]; 4] = {
 /// axis, its two halves), in `[0, 1)^2`.
 #[inline]
 pub fn point_2d(index: u32, seed: u64) -> [f32; 2] {
-    let [a, b, c, d] = index.to_le_bytes();
-    let y = BYTES[0][a as usize] ^ BYTES[1][b as usize] ^ BYTES[2][c as usize] ^ BYTES[3][d as usize];
     // Van der Corput's fraction reversed is the index itself.
-    [unit(scramble_reversed(index, seed as u32)), unit(scramble_reversed(y, (seed >> 32) as u32))]
+    let (x, y) = (index, second_dimension_reversed(index));
+    [unit_float(scramble_reversed(x, seed as u32)), unit_float(scramble_reversed(y, (seed >> 32) as u32))]
+}
+
+/// Sobol's second dimension of point `index`, bit-reversed, from the byte tables.
+#[inline]
+fn second_dimension_reversed(index: u32) -> u32 {
+    let [a, b, c, d] = index.to_le_bytes();
+    BYTES[0][a as usize] ^ BYTES[1][b as usize] ^ BYTES[2][c as usize] ^ BYTES[3][d as usize]
 }
 
 /// Point `index` of van der Corput's sequence (Sobol's first dimension), Owen-scrambled by `seed`, in
 /// `[0, 1)`.
 #[inline]
 pub fn point_1d(index: u32, seed: u32) -> f32 {
-    unit(scramble_reversed(index, seed))
+    unit_float(scramble_reversed(index, seed))
 }
 
 /// Owen's nested uniform scrambling of a 32-bit fraction given bit-reversed (`x`'s least significant
@@ -81,15 +89,15 @@ fn scramble_reversed(mut v: u32, seed: u32) -> u32 {
     v.reverse_bits()
 }
 
-/// The 32-bit fraction `x` as a float in `[0, 1)` (its top 24 bits: exact, never rounded up to 1).
-#[inline]
-fn unit(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Sobol's second dimension of point `i` by the definition: the XOR of the direction numbers of its
+    /// set bits.
+    fn bit_loop(i: u32) -> u32 {
+        (0..32).filter(|b| i >> b & 1 != 0).fold(0, |y, b| y ^ DIRECTIONS[b])
+    }
 
     /// Whether `points` (2^m of them) put one point in every box `2^-a x 2^-(m-a)`, for every `a`.
     fn is_net(points: &[[f32; 2]]) -> bool {
@@ -121,19 +129,11 @@ mod tests {
             }
         }
         // The unscrambled points are Sobol's own: (0, 0), (1/2, 1/2), (1/4, 3/4), (3/4, 1/4).
-        let raw: Vec<[u32; 2]> = (0..4u32)
-            .map(|i| {
-                let y = (0..32).filter(|b| i >> b & 1 != 0).fold(0, |y, b| y ^ DIRECTIONS[b]);
-                [i.reverse_bits() >> 30, y >> 30]
-            })
-            .collect();
+        let raw: Vec<[u32; 2]> = (0..4u32).map(|i| [i.reverse_bits() >> 30, bit_loop(i) >> 30]).collect();
         assert_eq!(raw, [[0, 0], [2, 2], [1, 3], [3, 1]]);
         // The byte tables give the bit loop's point for every index.
         for i in (0..5000u32).chain([0x1234_5678, u32::MAX, 1 << 31]) {
-            let y = (0..32).filter(|b| i >> b & 1 != 0).fold(0, |y, b| y ^ DIRECTIONS[b]);
-            let [a, b, c, d] = i.to_le_bytes();
-            let t = BYTES[0][a as usize] ^ BYTES[1][b as usize] ^ BYTES[2][c as usize] ^ BYTES[3][d as usize];
-            assert_eq!(t, y.reverse_bits(), "{i}");
+            assert_eq!(second_dimension_reversed(i), bit_loop(i).reverse_bits(), "{i}");
         }
     }
 
