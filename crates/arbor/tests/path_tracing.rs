@@ -309,6 +309,30 @@ fn path_unbiased_roulette_in_a_glowing_furnace_sums_every_bounce() {
 }
 
 #[test]
+fn path_mis_keeps_the_light_of_the_last_vertex() {
+    // In the glowing box (every face glows Le and reflects kd), next event estimation counts the camera
+    // hit's emission and one light sample at each of the D + 1 vertices: Le (1 - kd^(D+2)) / (1 - kd).
+    // MIS weighs each light sample against the bounce that could meet the same light, except at the
+    // last vertex, from which no bounce leaves: weighed there too, the last vertex's light went missing
+    // (at D = 0 a sixth of the image).
+    let (kd, le) = (0.5f32, 2.0);
+    for depth in [0, 1] {
+        let scene = glowing_box("0.5 0.5 0.5", "0.5 0.5 0.5", le, depth);
+        let want = le * (1.0 - kd.powi(depth as i32 + 2)) / (1.0 - kd);
+        for importance_sampling in [true, false] {
+            for mis in [false, true] {
+                let options = PathOptions { importance_sampling, next_event: true, mis, ..PathOptions::default() };
+                let got = channel_means(&scene, &path(&scene, options, 64, 1));
+                assert!(
+                    got.iter().all(|g| (g / want - 1.0).abs() < 0.02),
+                    "D {depth}, {options:?}: {got:?} against {want}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn path_wavefront_gives_each_sample_the_one_path_loops_radiance_bit_for_bit() {
     // The render steps a batch's paths together and traces their shadow and bounce rays in batches; a
     // live view's inspector traces one sample alone. Both must give every sample the same radiance, to
