@@ -72,7 +72,7 @@ impl PathTracer<'_> {
         // The light is worked out before the shadow ray is traced: the wavefront traces it later, with
         // the step's others, when this vertex's surface is gone.
         let w = if self.options.mis && ls.pdf > 0.0 {
-            power_heuristic(chosen * ls.pdf, at.mis_brdf * self.bounce_pdf(ns, ls.wi))
+            power_heuristic(chosen * ls.pdf, at.p_brdf * self.bounce_pdf(ns, ls.wi))
         } else {
             1.0
         };
@@ -141,8 +141,8 @@ pub(super) struct Vertex<'s> {
     /// The BRDF's value when it does not depend on the directions ([`Brdf::constant`]).
     pub(super) f: Option<Color>,
     /// The probability that the vertex's bounce samples its BRDF, against which MIS weighs its light
-    /// samples: 0 at the path's last vertex, from which no bounce leaves.
-    pub(super) mis_brdf: f32,
+    /// samples.
+    pub(super) p_brdf: f32,
     pub(super) time: f32,
 }
 

@@ -13,8 +13,8 @@
 //!   already (the course: "discard its contribution"). With `NextEventEstimation`, every vertex of a
 //!   surface with a BRDF part is lit by each light no ray can meet (point, spot, directional, the square
 //!   area light) and by one of the others, chosen in proportion to its power, each with a shadow ray; with
-//!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997), but at
-//!   the path's last vertex, whose bounce is never traced, where light samples count in full. Without
+//!   `MIS` the emitters met and sampled both count, weighted by the power heuristic (Veach 1997); the last
+//!   vertex's bounce is then traced too, for the light it meets only. Without
 //!   it, as in the course's plain references, lights no ray can meet give nothing (their radiance matches
 //!   Arbor's within 1% that way). After a delta lobe, met light always counts in full.
 //! - Length: at most `MaxRecursionDepth` bounces, or at random by one of the two Russian roulettes
@@ -175,6 +175,13 @@ impl<'a> PathTracer<'a> {
             });
             *own += p.beta * emitted * w;
         }
+        // Past the last vertex (reached by its bounce under MIS) a path only meets light.
+        if p.bounce > max_bounces {
+            if course {
+                shadows.course(p.t, &mut p.e, l, sample);
+            }
+            return None;
+        }
         // Only textured objects ask for their textures: the common case builds no shading terms.
         let textured =
             if scene.has_textures(s.object) { scene.textured(ray, &h, &mut s, Default::default()) } else { None };
@@ -224,11 +231,7 @@ impl<'a> PathTracer<'a> {
                 }
             }
         };
-        // No bounce leaves the path's last vertex, so no bounce can meet the light its light samples reach:
-        // under MIS they count in full there (weighed against a bounce that is never traced, the light of
-        // the last bounce went missing: 9% of `veach-ajar`'s at MaxRecursionDepth 1).
-        let mis_brdf = if p.bounce >= max_bounces { 0.0 } else { p_brdf };
-        let at = Vertex { s: &s, ns, wo: -d, kd, ks, brdf, f: brdf.constant(kd, ks), mis_brdf, time: ray.time };
+        let at = Vertex { s: &s, ns, wo: -d, kd, ks, brdf, f: brdf.constant(kd, ks), p_brdf, time: ray.time };
 
         // Light sampling, where a BRDF can take it (not at a delta surface's lobes).
         if has_brdf {
@@ -253,7 +256,12 @@ impl<'a> PathTracer<'a> {
             p.beta /= q;
         }
 
-        if p.bounce >= max_bounces {
+        // The last vertex's bounce is traced under MIS only, and only for the light it meets (the vertex
+        // past the last, above): its light samples are weighed against it, so without it their light would
+        // go missing (9% of `veach-ajar`'s at MaxRecursionDepth 1), and counted in full instead they bring
+        // back the light samples' fireflies near lights. Its lobes stay untraced, as without MIS.
+        let last = p.bounce >= max_bounces;
+        if last && !o.mis {
             return None;
         }
         // The next direction: a delta lobe of the specular layer, or a bounce over the hemisphere.
@@ -273,7 +281,7 @@ impl<'a> PathTracer<'a> {
         }
         let next = if part >= p_brdf {
             let total = lobe_total;
-            if total <= 0.0 {
+            if total <= 0.0 || last {
                 return None;
             }
             let mut pick = (part - p_brdf) / (1.0 - p_brdf) * total;
