@@ -25,7 +25,8 @@ libllvm19`; LIBLLVM below is used when DRJIT_LIBLLVM_PATH is unset and the file 
 What is translated: materials with SpecularReflectance 0 (any BRDF, or none) become Mitsuba `diffuse`
 with reflectance DiffuseReflectance; `dielectric` becomes `dielectric` (RefractionIndex; an
 AbsorptionCoefficient is dropped with a note); `mirror` becomes a `conductor` with
-specular_reflectance MirrorReflectance. A dielectric's or mirror's SpecularReflectance (a Phong lobe
+specular_reflectance MirrorReflectance, or with a DiffuseReflectance too (Arbor's sum of the two parts) a
+`blendbsdf` of the two, each divided by its weight. A dielectric's or mirror's SpecularReflectance (a Phong lobe
 beside the delta lobes, which neither Mitsuba BSDF has) is dropped with a note for both renderers:
 Arbor renders a copy of the scene without it (in --cache). A `LightMesh`/`LightSphere` Radiance is a Mitsuba `area`
 emitter (one-sided, on the side the triangle winding faces), a `PointLight` a `point` emitter.
@@ -40,10 +41,9 @@ otherwise gets, is biased) with no depth limit but its cap of 256 bounces, and M
 unless --mitsuba-sampler names another: `multijitter` or `stratified` stratify every dimension of a
 path and lower Mitsuba's noise at 64 spp by about a third; Arbor's default (`stratified`) stratifies
 its light and bounce samples too, `--arbor-sampler independent` only the pixel position. A flat-shaded PLY mesh
-(`<Faces plyFile=...>`) is read by Mitsuba from the same file, with the object's transformation. Anything
-else (a specular lobe, textures, smooth shading, non-uniformly scaled spheres, a lens, `AreaLight`) is
-refused with its reason and the scene skipped: Veach's `hw6/veach-ajar` is, for its textures (and its
-square `AreaLight` and Phong lobes behind them).
+(`<Faces plyFile=...>`) is read by Mitsuba from the same file, with the object's transformation, and so is a
+`MeshInstance` of it. Anything else (a specular lobe, textures, smooth shading, non-uniformly scaled spheres,
+a lens, `AreaLight`, a square that no ray meets) is refused with its reason and the scene skipped.
 
 The mesh-heavy scene: `igea-box:diffuse` or `igea-box:glass` as a SCENE argument generates (into --cache)
 the hw6 diffuse Cornell box with its spheres replaced by igea.ply (269k triangles) in white Lambertian or
@@ -52,6 +52,12 @@ referenced, not copied):
 
     ARBOR_SCENES=/work/shared/scenes ARBOR_MESHES=/work/shared/meshes scripts/mitsuba-compare.py \\
         --spp 64 --threads 1,2 --variants llvm_ad_rgb --ref-spp 256 igea-box:diffuse igea-box:glass
+
+Veach's door: `veach-ajar` as a SCENE argument generates (into --cache) `hw6/veach-ajar` (from $ARBOR_SCENES;
+21 objects, 382,624 triangles; camera 2, 1280x720, MaxRecursionDepth 6) as both renderers can render it:
+each texture replaced by its mean colour, the Phong lobes and the glass pots' absorption dropped, and the
+square `AreaLight` made two `LightMesh` quads back to back (geometry, as Mitsuba's emitters are). The
+script prints these notes.
 """
 
 import argparse
@@ -142,8 +148,17 @@ def read_material(mat, notes):
             notes.append(f"material {mid}: AbsorptionCoefficient dropped (Mitsuba `dielectric` has none)")
         return {"type": "dielectric", "int_ior": child_floats(mat, "RefractionIndex")[0], "ext_ior": 1.0}
     if kind == "mirror":
-        return {"type": "conductor", "material": "none",
-                "specular_reflectance": {"type": "rgb", "value": child_floats(mat, "MirrorReflectance")}}
+        kr = child_floats(mat, "MirrorReflectance")
+        mirror = {"type": "conductor", "material": "none", "specular_reflectance": {"type": "rgb", "value": kr}}
+        kd = child_floats(mat, "DiffuseReflectance", [0.0, 0.0, 0.0])
+        if not any(kd):
+            return mirror
+        # Arbor's mirror with a diffuse colour is the sum k_d/pi + k_r delta, its bounce picking a part by
+        # luminance; Mitsuba's blendbsdf is (1 - w) f_0 + w f_1, so each part is divided by its share.
+        w = luminance(kr) / (luminance(kd) + luminance(kr))
+        mirror["specular_reflectance"]["value"] = [c / w for c in kr]
+        return {"type": "blendbsdf", "weight": w, "bsdf_0": {
+            "type": "diffuse", "reflectance": {"type": "rgb", "value": [c / (1 - w) for c in kd]}}, "bsdf_1": mirror}
     if kind:
         raise Unsupported(f"material {mid}: type '{kind}' is not translated")
     if any(child_floats(mat, "SpecularReflectance", [0.0])):
@@ -153,6 +168,11 @@ def read_material(mat, notes):
         if any(child_floats(mat, legacy, [0.0])):
             raise Unsupported(f"material {mid}: untyped with {legacy} (legacy glass/mirror) is not translated")
     return {"type": "diffuse", "reflectance": {"type": "rgb", "value": child_floats(mat, "DiffuseReflectance")}}
+
+
+def luminance(c):
+    """Rec. 709 luminance, Arbor's (tonemap::luminance)."""
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 
 
 def write_ply(path, vertices, faces):
@@ -242,9 +262,22 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent",
     }
 
     objects = root.find("Objects")
+    meshes = {o.get("id").strip(): o for o in ([] if objects is None else objects.findall("Mesh"))}
     for k, obj in enumerate([] if objects is None else list(objects)):
-        shape = shape_of(obj, verts, transforms, tmp / f"{k}.ply", Path(path).parent)
-        shape["bsdf"] = read_material(materials[obj.findtext("Material").strip()], notes)
+        material = obj
+        if obj.tag == "MeshInstance":
+            # The base mesh's triangles under the instance's transform, after the base's own unless reset.
+            base = meshes.get((obj.get("baseMeshId") or "").strip())
+            if base is None:
+                raise Unsupported(f"MeshInstance {obj.get('id')}: its base is not a <Mesh>")
+            m = object_transform(obj, transforms)
+            if (obj.get("resetTransform") or "false").strip() != "true":
+                m = m @ object_transform(base, transforms)
+            shape = shape_of(base, verts, transforms, tmp / f"{k}.ply", Path(path).parent, m)
+            material = obj if obj.find("Material") is not None else base
+        else:
+            shape = shape_of(obj, verts, transforms, tmp / f"{k}.ply", Path(path).parent)
+        shape["bsdf"] = read_material(materials[material.findtext("Material").strip()], notes)
         if obj.tag.startswith("Light"):
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": child_floats(obj, "Radiance")}}
         scene[f"{obj.tag}_{obj.get('id')}"] = shape
@@ -263,10 +296,10 @@ def metu_to_mitsuba(path, camera_id, spp, max_depth, tmp, sampler="independent",
     return scene, cam, max_depth, notes
 
 
-def shape_of(obj, verts, transforms, ply_path, scene_dir):
+def shape_of(obj, verts, transforms, ply_path, scene_dir, m=None):
     """A Mitsuba shape dict (without BSDF) for a Mesh/LightMesh/Sphere/LightSphere element (a PLY mesh's
-    file relative to scene_dir)."""
-    m = object_transform(obj, transforms)
+    file relative to scene_dir), under the 4x4 matrix m (default: the object's own transformations)."""
+    m = object_transform(obj, transforms) if m is None else m
     if obj.tag in ("Sphere", "LightSphere"):
         linear = m[:3, :3]
         scale = abs(np.linalg.det(linear)) ** (1 / 3)
@@ -335,6 +368,103 @@ def igea_box(kind, out_dir):
     out = out_dir / f"igea_box_{kind}.xml"
     ET.ElementTree(root).write(out)
     return out
+
+
+def square_frame(light):
+    """(centre, side axis t, side axis u, unit normal, half side) of an AreaLight: its sides along Arbor's
+    orthonormal basis of its normal (math::orthonormal_basis, Duff et al. 2017), t x u = normal."""
+    pos, n = np.array(child_floats(light, "Position")), np.array(child_floats(light, "Normal"))
+    n = n / np.linalg.norm(n)
+    sign = math.copysign(1.0, n[2])
+    a = -1.0 / (sign + n[2])
+    b = n[0] * n[1] * a
+    t, u = np.array([1 + sign * n[0] ** 2 * a, sign * b, -sign * n[0]]), np.array([b, sign + n[1] ** 2 * a, -n[1]])
+    return pos, t, u, n, child_floats(light, "Size")[0] / 2
+
+
+def veach_ajar(out_dir):
+    """Writes `veach_ajar_untextured.xml` into out_dir and returns its path: Veach's door scene
+    (`ceng795-2022/hw6/veach-ajar/inputs/scene.xml` from $ARBOR_SCENES, 21 objects, 382,624 triangles in
+    all), camera 2, its PLY files referenced by their absolute paths, as both renderers render it: each
+    textured object's colour is its texture's mean (an image's 8-bit texels raised to 2.2, as Arbor
+    reads them; a checkerboard's two colours averaged), and the Phong lobes and the pots' absorption are
+    dropped. The notes say so."""
+    scenes = Path(os.environ.get("ARBOR_SCENES", "../shared/scenes"))
+    source = scenes / "ceng795-2022/hw6/veach-ajar/inputs/scene.xml"
+    if not source.is_file():
+        raise Unsupported(f"{source} is absent (set ARBOR_SCENES)")
+    root = ET.parse(source).getroot()
+    cameras = root.find("Cameras")
+    for cam in cameras.findall("Camera"):
+        if cam.get("id").strip() != "2":
+            cameras.remove(cam)
+    textures = root.find("Textures")
+    images = {i.get("id").strip(): source.parent / i.text.strip() for i in textures.findall("Images/Image")}
+    mi.set_variant(REF_VARIANT)
+    means = {}
+    for t in textures.findall("TextureMap"):
+        if (t.get("type") or "").strip() == "image":
+            texels = np.array(mi.Bitmap(str(images[t.findtext("ImageId").strip()])), dtype=np.float64)[..., :3]
+            means[t.get("id").strip()] = np.mean((texels / 255.0) ** 2.2, axis=(0, 1))
+        else:
+            means[t.get("id").strip()] = (np.array(child_floats(t, "BlackColor")) +
+                                          np.array(child_floats(t, "WhiteColor"))) / 2
+    root.remove(textures)
+    materials = root.find("Materials")
+    for m in materials.findall("Material"):
+        m.find("SpecularReflectance").text = "0 0 0"
+        if m.find("AbsorptionCoefficient") is not None:
+            m.find("AbsorptionCoefficient").text = "0 0 0"
+    by_id = {m.get("id").strip(): m for m in materials.findall("Material")}
+    for obj in root.find("Objects"):
+        faces = obj.find("Faces")
+        if faces is not None and faces.get("plyFile"):
+            faces.set("plyFile", str((source.parent / faces.get("plyFile").strip()).resolve()))
+        tex = obj.find("Textures")
+        if tex is None:
+            continue
+        obj.remove(tex)
+        # A material of its own: the texture's mean in place of the colour it replaced.
+        own = ET.fromstring(ET.tostring(by_id[obj.findtext("Material").strip()]))
+        own.set("id", str(100 + len(materials)))
+        own.find("DiffuseReflectance").text = " ".join(f"{c:.6f}" for c in means[tex.text.strip()])
+        materials.append(own)
+        obj.find("Material").text = own.get("id")
+    # The square light as geometry in both renderers: Mitsuba's emitters are surfaces, which rays meet and
+    # which shadow what lies behind them, and Arbor's square is not. Two one-sided quads back to back (the
+    # square lights both its sides), the back one a hair behind.
+    lights = root.find("Lights")
+    corners, faces = [], []
+    for square in lights.findall("AreaLight"):
+        lights.remove(square)
+        centre, t, u, n, half = square_frame(square)
+        for side, c in ((1, centre), (-1, centre - 1e-4 * half * n)):
+            base = len(corners)
+            corners += [c - half * t - half * u, c + half * t - half * u, c + half * t + half * u, c - half * t + half * u]
+            tris = [(0, 1, 2), (0, 2, 3)] if side == 1 else [(0, 2, 1), (0, 3, 2)]
+            faces.append((square.findtext("Radiance"), [[base + 1 + i for i in tri] for tri in tris]))
+    if corners:
+        vertex_data = root.find("VertexData")
+        if vertex_data is None:
+            vertex_data = ET.SubElement(root, "VertexData")
+        offset = len(floats(vertex_data.text)) // 3
+        vertex_data.text = (vertex_data.text or "") + "\n" + "\n".join(" ".join(f"{x:.7g}" for x in c) for c in corners)
+        black = ET.fromstring(f'<Material id="{100 + len(materials)}"><AmbientReflectance>0 0 0</AmbientReflectance>'
+                              "<DiffuseReflectance>0 0 0</DiffuseReflectance><SpecularReflectance>0 0 0"
+                              "</SpecularReflectance></Material>")
+        materials.append(black)
+        for k, (radiance, tris) in enumerate(faces):
+            text = " ".join(str(i + offset) for tri in tris for i in tri)
+            root.find("Objects").append(ET.fromstring(
+                f"<LightMesh id='{100 + k}'><Material>{black.get('id')}</Material><Radiance>{radiance}</Radiance>"
+                f"<Faces>{text}</Faces></LightMesh>"))
+    out = out_dir / "veach_ajar_untextured.xml"
+    ET.ElementTree(root).write(out)
+    return out
+
+
+VEACH_NOTES = ["veach-ajar: textures replaced by their mean colours, Phong lobes (SpecularReflectance) and the "
+               "pots' AbsorptionCoefficient dropped, for both renderers (Arbor renders veach_ajar_untextured.xml)"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -482,12 +612,15 @@ def references(args, path, camera_id, tag, arbor_ok):
 def compare_scene(args, spec, arbor_ok):
     """Rows of the table for one SCENE[:CAMERA] argument."""
     path, _, camera_id = spec.partition(":")
-    if path == "igea-box":
-        try:
+    generated = []
+    try:
+        if path == "igea-box":
             path, camera_id = igea_box(camera_id, args.cache), "1"
-        except Unsupported as e:
-            print(f"{spec}\n  skipped: {e}")
-            return []
+        elif path == "veach-ajar":
+            path, camera_id, generated = veach_ajar(args.cache), "2", VEACH_NOTES
+    except Unsupported as e:
+        print(f"{spec}\n  skipped: {e}")
+        return []
     path = Path(path)
     print(f"{path.name}{':' + camera_id if camera_id else ''}", flush=True)
     mi.set_variant(REF_VARIANT)
@@ -498,7 +631,7 @@ def compare_scene(args, spec, arbor_ok):
         print(f"  skipped: {e}")
         return []
     args.arbor_path, dropped = arbor_scene(path, args.cache)
-    for note in notes + dropped:
+    for note in generated + notes + dropped:
         print(f"  note: {note}")
     camera_id = cam["id"]
     tag = f"{path.stem}_cam{camera_id}_d{depth}{'_rr' if args.roulette else ''}{'_nolobes' if dropped else ''}"
