@@ -8,11 +8,40 @@ use crate::integrator::offset::shadow_ray;
 use crate::integrator::roulette;
 use crate::integrator::RayLog;
 use crate::material::Brdf;
-use crate::math::{Color, Ray, Vec2, Vec3};
+use crate::math::{Aabb, Color, Ray, Vec2, Vec3};
 use crate::sampler::SampleStream;
-use crate::scene::{SceneGeometry, Surface};
+use crate::scene::{Scene, SceneGeometry, Surface};
+
+/// The world boxes of the scene's emitting objects, each grown by a little more than rounding, for
+/// [`PathTracer::may_meet_light`]; `None` when a ray may meet light anywhere (an environment, or an
+/// emitting plane).
+pub(super) fn light_boxes(scene: &Scene) -> Option<Vec<Aabb>> {
+    let emits = |object: u32| scene.object_emission.get(object as usize).is_some_and(|e| e.is_some());
+    let g = &scene.geometry;
+    if scene.environment.is_some() || g.planes.iter().any(|p| emits(p.object)) {
+        return None;
+    }
+    let grown = |b: Aabb| {
+        let pad = Vec3::splat(1e-4 * b.min.abs().max(b.max.abs()).max_element().max(1.0));
+        Aabb::new(b.min - pad, b.max + pad)
+    };
+    Some(g.objects.objects.iter().filter(|o| emits(o.object)).map(|o| grown(o.bounds)).collect())
+}
 
 impl PathTracer<'_> {
+    /// Whether a ray from `o` along `d` may meet an emitting object: false only when it misses every
+    /// emitter's box. (A ray along a grown box's face, where a lane's slab test is NaN, lies outside
+    /// the emitter itself.) Costs a slab test per emitter.
+    pub(super) fn may_meet_light(&self, o: Vec3, d: Vec3) -> bool {
+        let Some(boxes) = &self.light_boxes else { return true };
+        let inv = d.recip();
+        boxes.iter().any(|b| {
+            let (t0, t1) = ((b.min - o) * inv, (b.max - o) * inv);
+            let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+            !(near > far || far < 0.0)
+        })
+    }
+
     /// A light chosen in proportion to its power by `u` in [0, 1), and the probability of that choice.
     #[inline]
     pub(super) fn choose_light(&self, u: f32) -> Option<(usize, f32)> {
@@ -166,5 +195,63 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
         1.0
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::AccelConfig;
+    use crate::renderer::PathOptions;
+    use crate::sampler::Rng;
+    use crate::scene::parse_desc;
+
+    /// Every ray whose closest hit is an emitter passes [`PathTracer::may_meet_light`], and most others
+    /// do not: a ceiling quad of zero thickness (its box flat in z), a scaled and moved sphere, and a
+    /// wall between them that glows not.
+    #[test]
+    fn rays_that_meet_an_emitter_pass_the_light_boxes() {
+        let text = r#"<Scene><Cameras><Camera id="1"><Position>0 0 5</Position><Gaze>0 0 -1</Gaze>
+            <Up>0 1 0</Up><NearPlane>-1 1 -1 1</NearPlane><NearDistance>2</NearDistance>
+            <ImageResolution>4 4</ImageResolution><ImageName>l.png</ImageName></Camera></Cameras>
+            <Materials><Material id="1"><AmbientReflectance>0 0 0</AmbientReflectance><DiffuseReflectance>0.5 0.5 0.5</DiffuseReflectance>
+            <SpecularReflectance>0 0 0</SpecularReflectance></Material></Materials>
+            <Transformations><Scaling id="1">0.3 0.3 0.3</Scaling><Translation id="1">2 -1 0.5</Translation></Transformations>
+            <VertexData>-1 -1 2  1 -1 2  1 1 2  -1 1 2  0 0 0  -3 -3 0  3 -3 0  3 3 0</VertexData>
+            <Objects>
+                <LightMesh id="1"><Material>1</Material><Radiance>5 5 5</Radiance><Faces>1 3 2 1 4 3</Faces></LightMesh>
+                <LightSphere id="1"><Material>1</Material><Center>5</Center><Radius>1</Radius>
+                    <Radiance>2 2 2</Radiance><Transformations>s1 t1</Transformations></LightSphere>
+                <Mesh id="1"><Material>1</Material><Faces>6 7 8</Faces></Mesh>
+            </Objects></Scene>"#;
+        let scene =
+            Scene::build(parse_desc(text, std::path::Path::new("l.xml")).unwrap(), &AccelConfig::default(), None)
+                .unwrap();
+        let tracer = PathTracer::new(&scene, PathOptions::default(), false);
+        assert_eq!(tracer.light_boxes.as_ref().map(Vec::len), Some(2));
+        let (mut met, mut passed_by) = (0, 0);
+        let mut rng = Rng::for_sample(1, 2, 3, 4);
+        for _ in 0..20_000 {
+            let o = Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 4.0 - 1.0);
+            let d = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5);
+            let ray = Ray::new(o, d);
+            let emitter = scene.geometry.intersect(&ray, f32::INFINITY).is_some_and(|h| {
+                let s = scene.surface(&ray, &h);
+                scene.object_emission[s.object as usize].is_some()
+            });
+            let may = tracer.may_meet_light(o, d);
+            assert!(may || !emitter, "a ray from {o} along {d} meets an emitter its box test missed");
+            met += emitter as u32;
+            passed_by += !may as u32;
+        }
+        assert!(met > 300 && passed_by > 5_000, "{met} rays met emitters, {passed_by} were turned away");
+        // With an environment any ray may meet light.
+        let mut with_env = scene;
+        with_env.environment = Some(crate::light::environment::EnvMap::from_film_latlong(crate::film::Film {
+            width: 2,
+            height: 1,
+            pixels: vec![Color::ONE; 2],
+        }));
+        assert!(light_boxes(&with_env).is_none());
     }
 }

@@ -46,7 +46,7 @@ use super::RayLog;
 use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::material::{beer, Brdf, BrdfModel, Material};
-use crate::math::{Color, Ray, Vec3};
+use crate::math::{Aabb, Color, Ray, Vec3};
 use crate::renderer::{PathOptions, Roulette};
 use crate::sampler::SampleStream;
 use crate::scene::Scene;
@@ -74,6 +74,9 @@ pub struct PathTracer<'a> {
     on_surface: Vec<bool>,
     /// The BRDF of each material as the path tracer shades it ([`path_brdf`]).
     brdfs: Vec<Brdf>,
+    /// The emitting objects' boxes ([`light::light_boxes`]): the last vertex's bounce, which only
+    /// looks for light, is not traced when it misses them all.
+    light_boxes: Option<Vec<Aabb>>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -94,7 +97,20 @@ impl<'a> PathTracer<'a> {
         let several = pick.iter().filter(|&&p| p > 0.0).count() > 1;
         let on_surface = scene.lights.iter().map(|l| l.object().is_some()).collect();
         let brdfs = scene.materials.iter().map(path_brdf).collect();
-        PathTracer { scene, options, cull_backfaces, camera: None, pick, always, last_pick, several, on_surface, brdfs }
+        let light_boxes = light::light_boxes(scene);
+        PathTracer {
+            scene,
+            options,
+            cull_backfaces,
+            camera: None,
+            pick,
+            always,
+            last_pick,
+            several,
+            on_surface,
+            brdfs,
+            light_boxes,
+        }
     }
 
     /// The path tracer for the camera rays of `camera`.
@@ -328,7 +344,11 @@ impl<'a> PathTracer<'a> {
             return None;
         }
         p.bounce += 1;
-        Some((spawn_origin(scene.offset, &s, next), next))
+        let origin = spawn_origin(scene.offset, &s, next);
+        if last && !self.may_meet_light(origin, next) {
+            return None;
+        }
+        Some((origin, next))
     }
 
     /// The next branch of a split path to trace, after Arbor's unbiased roulette (the roulette a bounce
