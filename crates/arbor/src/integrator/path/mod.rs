@@ -36,6 +36,7 @@
 //! which records every query in order); both give a sample the same radiance, bit for bit.
 
 mod light;
+mod state;
 mod wavefront;
 
 use super::hemisphere::{cosine_hemisphere, uniform_hemisphere};
@@ -51,6 +52,7 @@ use crate::renderer::{PathOptions, Roulette};
 use crate::sampler::SampleStream;
 use crate::scene::Scene;
 use light::{Now, Shadows, Vertex};
+use state::PathState;
 
 /// The path tracer for one render.
 pub struct PathTracer<'a> {
@@ -379,35 +381,6 @@ impl<'a> PathTracer<'a> {
 /// with its Phong exponent.
 fn path_brdf(m: &Material) -> Brdf {
     m.brdf.unwrap_or(Brdf { model: BrdfModel::ModifiedBlinnPhong { normalized: true }, exponent: m.phong_exponent })
-}
-
-/// What a path carries from one vertex to the next.
-struct PathState {
-    /// Under the course's roulette, the light of the vertex being shaded, until the roulette weighs it
-    /// (zero between vertices, but while its shadow rays wait to be traced).
-    e: Color,
-    beta: Color,
-    /// The absorption of the medium the ray travels in (inside a dielectric), if any.
-    inside: Option<Color>,
-    /// The last bounce: the point it left from and its direction's density, for the weight of the light
-    /// it meets; `None` after a delta lobe (or for the camera ray), which meets light in full.
-    last: Option<(Vec3, f32)>,
-    /// The course's roulette's throughput: the product of the BRDF values met so far.
-    t: Color,
-    bounce: u32,
-}
-
-impl PathState {
-    /// The state of a camera ray's path.
-    fn camera() -> PathState {
-        PathState { e: Color::ZERO, beta: Color::ONE, inside: None, last: None, t: Color::ONE, bounce: 0 }
-    }
-
-    /// The state of a branch of a split path, which takes over the light `e` still waiting for the
-    /// roulette of the vertex that made it.
-    fn branch(b: &Branch, e: Color) -> PathState {
-        PathState { e, beta: b.beta, inside: b.inside, last: None, t: b.t, bounce: b.bounce }
-    }
 }
 
 fn luminance(c: Color) -> f32 {
