@@ -92,7 +92,10 @@ pub fn encode_partial(path: &Path, part: &Partial) -> Result<Vec<u8>> {
         .write()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::Invalid(format!("cannot encode {}: {e}", path.display())))?;
-    Ok(bytes.into_inner())
+    let mut bytes = bytes.into_inner();
+    // The same partial, the same bytes (the attributes come out of a HashMap).
+    crate::image_io::sort_exr_header(&mut bytes);
+    Ok(bytes)
 }
 
 /// Bytes of a pixel of a partial: the 16 channels of 4 bytes each.

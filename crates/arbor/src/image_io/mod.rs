@@ -33,7 +33,7 @@ pub use limits::ImageLimits;
 pub use metrics::{
     compare_blocks_files, compare_blocks_rgb8, compare_files, compare_rgb8, diff_image, BlockComparison, Comparison,
 };
-pub(crate) use openexr::in_parallel as exr_in_parallel;
+pub(crate) use openexr::{in_parallel as exr_in_parallel, sort_header_attributes as sort_exr_header};
 pub use read::{check_finite, decode, read, read_image, read_image_within, read_rgb8, Texel};
 pub use write::{
     encode_outputs, is_hdr_path, tone_mapped_beside, write_files, write_image, write_outputs,

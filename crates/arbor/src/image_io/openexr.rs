@@ -34,6 +34,42 @@ pub(crate) fn in_parallel(headers: &[Header]) -> bool {
     headers.iter().map(|h| h.layer_size.area() as u64).sum::<u64>() >= PARALLEL
 }
 
+/// Puts the attributes of a single-part OpenEXR file's header (`bytes`, as the exr crate wrote it) in
+/// the order of their names: the crate writes custom attributes in a `HashMap`'s order, which changes
+/// from one map to the next, so the same image written twice differed in its bytes. The header keeps its
+/// length, so the offset table after it stays right. A header it cannot read (multi-part, or cut short)
+/// is left as it is.
+pub(crate) fn sort_header_attributes(bytes: &mut [u8]) {
+    const MULTI_PART: u32 = 0x1000;
+    let Some(version) = bytes.get(4..8).map(|v| u32::from_le_bytes([v[0], v[1], v[2], v[3]])) else { return };
+    if version & MULTI_PART != 0 {
+        return;
+    }
+    // Each attribute: name, NUL, type name, NUL, a 4-byte little-endian size, then that many bytes; an
+    // empty name (a lone NUL) ends the header.
+    let (start, mut at, mut spans) = (8, 8, Vec::new());
+    let nul = |from: usize| bytes.get(from..)?.iter().position(|&b| b == 0).map(|i| from + i);
+    loop {
+        match bytes.get(at) {
+            None => return,
+            Some(0) => break,
+            Some(_) => {}
+        }
+        let Some(name_end) = nul(at) else { return };
+        let Some(type_end) = nul(name_end + 1) else { return };
+        let Some(size) = bytes.get(type_end + 1..type_end + 5) else { return };
+        let end = type_end + 5 + u32::from_le_bytes([size[0], size[1], size[2], size[3]]) as usize;
+        if end > bytes.len() {
+            return;
+        }
+        spans.push((at, name_end, end));
+        at = end;
+    }
+    spans.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
+    let sorted: Vec<u8> = spans.iter().flat_map(|&(from, _, end)| bytes[from..end].iter().copied()).collect();
+    bytes[start..at].copy_from_slice(&sorted);
+}
+
 /// The pixels of the OpenEXR file `bytes` as native-endian float RGB: `(width, height, Rgb32F, bytes)`.
 pub(super) fn decode_rgb(bytes: &[u8], path: &Path, limits: &ImageLimits) -> Result<(u32, u32, ColorType, Vec<u8>)> {
     let bad = |e: exr::error::Error| {
