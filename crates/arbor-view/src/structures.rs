@@ -133,13 +133,19 @@ impl Structures {
         let done = Arc::new(AtomicBool::new(false));
         let (ticker_done, events, purpose_owned) = (done.clone(), self.events.clone(), purpose.to_string());
         let start = Instant::now();
-        let ticker = std::thread::spawn(move || {
-            while !ticker_done.load(Ordering::Acquire) {
-                let ms = start.elapsed().as_secs_f64() * 1e3;
-                let event = json!({"type": "build", "state": "running", "kind": kind, "purpose": purpose_owned, "elapsed_ms": ms});
-                let _ = events.send(event.to_string());
-                std::thread::park_timeout(TICK);
+        let running = move |ms: f64| {
+            json!({"type": "build", "state": "running", "kind": kind, "purpose": purpose_owned, "elapsed_ms": ms})
+                .to_string()
+        };
+        // The first report goes out before the build starts: a build over before the ticker's thread
+        // got to run showed no "running" at all.
+        let _ = events.send(running(0.0));
+        let ticker = std::thread::spawn(move || loop {
+            std::thread::park_timeout(TICK);
+            if ticker_done.load(Ordering::Acquire) {
+                break;
             }
+            let _ = events.send(running(start.elapsed().as_secs_f64() * 1e3));
         });
         let scene = Scene::build(self.desc.clone(), config, None).map(Arc::new);
         done.store(true, Ordering::Release);
