@@ -370,6 +370,14 @@ def igea_box(kind, out_dir):
     return out
 
 
+def absolute_ply_files(root, scene_dir):
+    """Names every `plyFile` of the METU scene `root` by its full path (relative ones are relative to
+    scene_dir), for a copy of the scene written elsewhere."""
+    for el in root.iter():
+        if el.get("plyFile"):
+            el.set("plyFile", str((Path(scene_dir) / el.get("plyFile").strip()).resolve()))
+
+
 def square_frame(light):
     """(centre, side axis t, side axis u, unit normal, half side) of an AreaLight: its sides along Arbor's
     orthonormal basis of its normal (math::orthonormal_basis, Duff et al. 2017), t x u = normal."""
@@ -417,9 +425,6 @@ def veach_ajar(out_dir):
             m.find("AbsorptionCoefficient").text = "0 0 0"
     by_id = {m.get("id").strip(): m for m in materials.findall("Material")}
     for obj in root.find("Objects"):
-        faces = obj.find("Faces")
-        if faces is not None and faces.get("plyFile"):
-            faces.set("plyFile", str((source.parent / faces.get("plyFile").strip()).resolve()))
         tex = obj.find("Textures")
         if tex is None:
             continue
@@ -458,6 +463,7 @@ def veach_ajar(out_dir):
             root.find("Objects").append(ET.fromstring(
                 f"<LightMesh id='{100 + k}'><Material>{black.get('id')}</Material><Radiance>{radiance}</Radiance>"
                 f"<Faces>{text}</Faces></LightMesh>"))
+    absolute_ply_files(root, source.parent)
     out = out_dir / "veach_ajar_untextured.xml"
     ET.ElementTree(root).write(out)
     return out
@@ -576,10 +582,7 @@ def arbor_scene(path, cache):
         return path, []
     for m in dropped:
         m.find("SpecularReflectance").text = "0 0 0"
-    # The copy lives elsewhere: files it names are given by their full paths.
-    for el in tree.getroot().iter():
-        if el.get("plyFile"):
-            el.set("plyFile", str((Path(path).parent / el.get("plyFile").strip()).resolve()))
+    absolute_ply_files(tree.getroot(), Path(path).parent)
     copy = Path(cache) / f"{Path(path).stem}_without_lobes.xml"
     tree.write(copy)
     ids = ", ".join(m.get("id") for m in dropped)
