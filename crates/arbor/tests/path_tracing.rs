@@ -401,7 +401,7 @@ fn path_wavefront_gives_each_sample_the_one_path_loops_radiance_bit_for_bit() {
         options.push(PathOptions { importance_sampling, next_event, roulette, mis, split_refraction });
     }
     for sampler in [SamplerKind::Stratified, SamplerKind::Independent, SamplerKind::Sobol] {
-        for &o in &options {
+        for (n, &o) in options.iter().enumerate() {
             let integrator = Integrator::new(&scene, cam, Renderer::PathTracing(o), false);
             let (mut rays, mut streams, mut hits) = (Vec::new(), Vec::new(), Vec::new());
             for (x, y, k) in (0..12).flat_map(|y| (0..12).flat_map(move |x| (0..spp).map(move |k| (x, y, k)))) {
@@ -420,8 +420,16 @@ fn path_wavefront_gives_each_sample_the_one_path_loops_radiance_bit_for_bit() {
                 })
                 .collect();
             let rays_alone = log.rays;
+            // Two batches of different sizes, one after the other on this thread: whatever the
+            // wavefront keeps between batches must not carry over.
             let mut log = RayLog::default();
-            integrator.li_camera_batch(&rays, &hits, &mut streams, &mut log, &mut batch);
+            let cut = 1 + (n * 97) % (rays.len() - 1);
+            let (first, second) = streams.split_at_mut(cut);
+            let mut part = Vec::new();
+            integrator.li_camera_batch(&rays[..cut], &hits[..cut], first, &mut log, &mut part);
+            batch.extend_from_slice(&part);
+            integrator.li_camera_batch(&rays[cut..], &hits[cut..], second, &mut log, &mut part);
+            batch.extend_from_slice(&part);
             let bits = |c: &Color| c.to_array().map(f32::to_bits);
             let differ = alone.iter().zip(&batch).filter(|(a, b)| bits(a) != bits(b)).count();
             assert_eq!(differ, 0, "{sampler:?} {o:?}: {differ} of {} samples differ", rays.len());

@@ -10,7 +10,7 @@
 //! step's any-hit batch, the course's roulette's weighing of the vertex's light with it, and both come
 //! before the path's next vertex), so the radiance of every sample is the same, bit for bit, and so is
 //! every image. Costs: per path in flight about 200 bytes of state, in buffers each thread keeps for its
-//! next batch (growing them anew for every batch of 256 cost 2% of a Cornell box's instructions); per
+//! next batch (growing them anew for every batch of 256 cost 1.5% of a Cornell box's instructions); per
 //! step one any-hit and one closest-hit batch, and the state of each live path read and written once.
 
 use super::light::Shadows;
