@@ -23,7 +23,7 @@ use crate::math::{Color, Ray};
 use crate::renderer::Roulette;
 use crate::sampler::SampleStream;
 use crate::scene::SceneGeometry;
-use std::cell::RefCell;
+use std::cell::Cell;
 
 /// One path in flight.
 struct Path {
@@ -86,7 +86,8 @@ struct Buffers {
 }
 
 thread_local! {
-    static BUFFERS: RefCell<Buffers> = RefCell::default();
+    /// Taken for a batch and put back after it (a nested call, which none makes, would find empty ones).
+    static BUFFERS: Cell<Buffers> = Cell::default();
 }
 
 impl PathTracer<'_> {
@@ -105,28 +106,12 @@ impl PathTracer<'_> {
         out: &mut Vec<Color>,
     ) {
         assert!(rays.len() == hits.len() && rays.len() == streams.len(), "a batch's rays, hits and streams differ");
-        // A nested call (none is made) would find the buffers taken and use its own.
-        BUFFERS.with(|b| match b.try_borrow_mut() {
-            Ok(mut b) => self.step_batch(rays, hits, streams, log, out, &mut b),
-            Err(_) => self.step_batch(rays, hits, streams, log, out, &mut Buffers::default()),
-        });
-    }
-
-    /// [`PathTracer::li_camera_batch`] with the buffers `b`.
-    fn step_batch(
-        &self,
-        rays: &[Ray],
-        hits: &[Option<Hit>],
-        streams: &mut [SampleStream],
-        log: &mut RayLog,
-        out: &mut Vec<Color>,
-        b: &mut Buffers,
-    ) {
         let g = &self.scene.geometry;
         // Under the course's roulette a vertex's shadow-ray light is its own, which the roulette weighs.
         let course = self.options.roulette == Roulette::Course;
         log.rays += rays.len() as u64;
-        let Buffers { paths, live, hit, next, next_rays, ops, shadow_rays, shadow_t_max, occluded } = b;
+        let mut b = BUFFERS.take();
+        let Buffers { paths, live, hit, next, next_rays, ops, shadow_rays, shadow_t_max, occluded } = &mut b;
         paths.clear();
         paths.extend(rays.iter().map(|&ray| Path {
             ray,
@@ -191,5 +176,6 @@ impl PathTracer<'_> {
         }
         out.clear();
         out.extend(paths.iter().map(|p| p.l));
+        BUFFERS.set(b);
     }
 }
