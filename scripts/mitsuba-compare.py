@@ -408,11 +408,10 @@ def veach_ajar(out_dir):
             cameras.remove(cam)
     textures = root.find("Textures")
     images = {i.get("id").strip(): source.parent / i.text.strip() for i in textures.findall("Images/Image")}
-    mi.set_variant(REF_VARIANT)
     means = {}
     for t in textures.findall("TextureMap"):
         if (t.get("type") or "").strip() == "image":
-            texels = np.array(mi.Bitmap(str(images[t.findtext("ImageId").strip()])), dtype=np.float64)[..., :3]
+            texels = read_bitmap(images[t.findtext("ImageId").strip()])
             means[t.get("id").strip()] = np.mean((texels / 255.0) ** 2.2, axis=(0, 1))
         else:
             means[t.get("id").strip()] = (np.array(child_floats(t, "BlackColor")) +
@@ -530,7 +529,7 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
               (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
         return None
     render_ms = json.loads(stats.read_text())["images"][0]["render_ms"]
-    return read_exr(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
+    return read_bitmap(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
 
 def bitmap_io(io):
@@ -544,7 +543,8 @@ def bitmap_io(io):
         dr.set_thread_count(threads)
 
 
-def read_exr(path):
+def read_bitmap(path):
+    """An image file Mitsuba's Bitmap reads (EXR, PNG, JPEG) as float64 RGB, as stored (8-bit files: 0-255)."""
     mi.set_variant(REF_VARIANT)
     return bitmap_io(lambda: np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3])
 
@@ -599,7 +599,7 @@ def references(args, path, camera_id, tag, arbor_ok):
         img, _ = render_mitsuba(REF_VARIANT, path, camera_id, args.ref_spp, max(args.threads), args.max_depth, seed=1,
                                 roulette=args.roulette)
         write_exr(mitsuba_file, img)
-    refs["Mitsuba"] = read_exr(mitsuba_file)
+    refs["Mitsuba"] = read_bitmap(mitsuba_file)
     # "radiance": Arbor's EXRs hold radiance in the scene's units (older caches held it times 1/255).
     arbor_file = args.cache / f"{tag}_arbor_{args.arbor_path_options or 'scene'}_{args.ref_spp}spp_radiance.exr"
     refs["Arbor"] = None
@@ -608,7 +608,7 @@ def references(args, path, camera_id, tag, arbor_ok):
         render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options, args.arbor_path, camera_id,
                      args.ref_spp, max(args.threads), arbor_file, seed=1)
     if arbor_ok and arbor_file.exists():
-        refs["Arbor"] = read_exr(arbor_file)
+        refs["Arbor"] = read_bitmap(arbor_file)
     return refs
 
 
@@ -643,7 +643,7 @@ def compare_scene(args, spec, arbor_ok):
     refs = references(args, path, camera_id, tag, arbor_ok)
     official = path.parent.parent / "outputs" / cam["image_name"]
     if official.exists():
-        ref, off = refs["Mitsuba"], read_exr(official)
+        ref, off = refs["Mitsuba"], read_bitmap(official)
         print(f"  Mitsuba {args.ref_spp} spp vs official {official.name}: mean ratio {ref.mean() / off.mean():.4f}, "
               f"mean |relative difference| {mean_relative_difference(ref, off):.4f} per pixel, "
               f"{mean_relative_difference(ref, off, 16):.4f} in 16x16 blocks")
