@@ -198,15 +198,7 @@ fn path_stratified_and_sobol_samplers_keep_the_mean_and_lower_the_noise() {
                     render(&scene, 0, &opts, &|_, _| {}).unwrap().0
                 })
                 .collect();
-            let n = films[0].pixels.len();
-            let value = |f: &Film, i: usize| f.pixels[i].x + f.pixels[i].y + f.pixels[i].z;
-            let var = (0..n)
-                .map(|i| {
-                    let mu = films.iter().map(|f| value(f, i)).sum::<f32>() / films.len() as f32;
-                    films.iter().map(|f| (value(f, i) - mu).powi(2)).sum::<f32>() / (films.len() - 1) as f32
-                })
-                .sum::<f32>()
-                / n as f32;
+            let var = pixel_variance(&films, |c| c.x + c.y + c.z);
             (films.iter().map(mean).sum::<f32>() / films.len() as f32, var)
         };
         let (mean_i, var_i) = noise(SamplerKind::Independent);
@@ -330,7 +322,7 @@ fn path_mis_weighs_the_last_vertexs_light_samples_against_its_traced_bounce() {
                     got.iter().all(|g| (g / want - 1.0).abs() < 0.02),
                     "D {depth}, {options:?}: {got:?} against {want}"
                 );
-                variance[k] = pixel_variance(&films);
+                variance[k] = pixel_variance(&films, |c| c.x);
             }
             let ratio = variance[1] / variance[0];
             assert!(
@@ -341,15 +333,15 @@ fn path_mis_weighs_the_last_vertexs_light_samples_against_its_traced_bounce() {
     }
 }
 
-/// The variance over the films (renders of one scene with different seeds) of each pixel's red value,
+/// The variance over the films (renders of one scene with different seeds) of each pixel's `value`,
 /// averaged over the pixels.
-fn pixel_variance(films: &[Film]) -> f32 {
+fn pixel_variance(films: &[Film], value: impl Fn(&Color) -> f32) -> f32 {
     let n = films.len() as f32;
     let pixels = films[0].pixels.len();
     (0..pixels)
         .map(|i| {
-            let mean = films.iter().map(|f| f.pixels[i].x).sum::<f32>() / n;
-            films.iter().map(|f| (f.pixels[i].x - mean).powi(2)).sum::<f32>() / (n - 1.0)
+            let mean = films.iter().map(|f| value(&f.pixels[i])).sum::<f32>() / n;
+            films.iter().map(|f| (value(&f.pixels[i]) - mean).powi(2)).sum::<f32>() / (n - 1.0)
         })
         .sum::<f32>()
         / pixels as f32
