@@ -33,7 +33,15 @@ use clap::{Parser, Subcommand};
 
 /// A ray tracer for triangle meshes built around fast and exactly correct acceleration structures.
 #[derive(Parser)]
-#[command(name = "arbor", version, about, long_about = None)]
+#[command(
+    name = "arbor",
+    version,
+    about,
+    long_about = None,
+    after_help = "Environment: ARBOR_MAX_ISA=avx2 (or sse) caps the structures' SIMD kernel below the \
+                  processor's best, to measure Arbor as it runs on an older processor; `--stats-json` \
+                  and `arbor bench` name the kernel that ran."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -101,6 +109,10 @@ pub fn shown(path: &Option<PathBuf>) -> String {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Checked before any work: the kernel reads it at the first query and would take a typo as no cap.
+    if let Err(msg) = arbor::accel::bvh::Isa::cap_from_env() {
+        return report(Failure::Usage(msg));
+    }
     let stopped = match cli.command {
         Command::Render(_) => signals::RENDER_STOPPED,
         Command::Merge(_) => signals::MERGE_STOPPED,

@@ -343,6 +343,7 @@ pub fn run(args: RenderArgs, signals: &Signals) -> Result<(), Failure> {
             "rays": stats.rays,
             "mrays_per_s": stats.mrays_per_s(),
             "traversal_share": stats.traversal_share(),
+            "kernel": arbor::accel::bvh::query_kernel(),
             "threads": rayon::current_num_threads(),
             "triangles": scene.geometry.counts.triangles,
         }));

@@ -535,3 +535,40 @@ fn cli_build_times_are_wall_times() {
         assert!(build_ms <= ms, "bench --accel {accel}: build {build_ms} ms, {ms} ms in all");
     }
 }
+
+#[test]
+fn cli_max_isa_caps_the_kernel_keeps_the_image_and_refuses_unknown_values() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |isa: Option<&str>, out: &str| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_arbor"));
+        c.args(["render", "-o", out, "--spp", "1", "--stats-json", &format!("{out}.json")]).current_dir(tmp.path());
+        match isa {
+            Some(v) => c.env("ARBOR_MAX_ISA", v),
+            None => c.env_remove("ARBOR_MAX_ISA"),
+        };
+        let o = c.output().expect("arbor runs");
+        assert!(o.status.success() || isa == Some("avx3"), "{isa:?}: {}", stderr(&o));
+        o
+    };
+    let kernel = |out: &str| {
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(tmp.path().join(format!("{out}.json"))).unwrap()).unwrap();
+        stats["images"][0]["kernel"].as_str().unwrap().to_string()
+    };
+    run(None, "best");
+    let best = kernel("best");
+    let image = |out: &str| std::fs::read(tmp.path().join(out).join("cornell_box.png")).unwrap();
+    // The kernels compute the same lanes in the same order: a capped render is the same image.
+    let order = ["scalar", "sse", "avx2", "avx512"];
+    let rank = |k: &str| order.iter().position(|&o| o == k).unwrap_or_else(|| panic!("kernel {k}"));
+    for cap in ["sse", "avx2", "avx512"] {
+        run(Some(cap), cap);
+        let expected = if best == "scalar" { "scalar" } else { order[rank(&best).min(rank(cap))] };
+        assert_eq!(kernel(cap), expected, "ARBOR_MAX_ISA={cap} on a processor whose best is {best}");
+        assert!(image(cap) == image("best"), "ARBOR_MAX_ISA={cap} changed the image");
+    }
+    let o = run(Some("avx3"), "typo");
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(stderr(&o), "error: ARBOR_MAX_ISA=\"avx3\": expected avx512, avx2 or sse\n");
+    assert!(!tmp.path().join("typo").exists() && !tmp.path().join("typo.json").exists());
+}

@@ -181,7 +181,7 @@ fn farm_cli_stats_json_and_plain_progress_lines() {
     assert_eq!((image["width"].as_u64(), image["height"].as_u64()), (Some(29), Some(31)));
     assert_eq!(image["window"], serde_json::json!([0, 0, 29, 31]));
     assert_eq!(image["samples"], serde_json::json!([0, 4]));
-    for key in ["spp", "accel", "build_ms", "render_ms", "rays", "mrays_per_s", "threads"] {
+    for key in ["spp", "accel", "build_ms", "render_ms", "rays", "mrays_per_s", "threads", "kernel"] {
         assert!(!image[key].is_null(), "{key} missing");
     }
 }

@@ -58,6 +58,8 @@ fn accel_kinds(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
 /// The extension module, `arbor_rays._native`.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // As `arbor` does at start: the kernel would take a typo in the cap as no cap.
+    arbor::accel::bvh::Isa::cap_from_env().map_err(pyo3::exceptions::PyValueError::new_err)?;
     m.add_class::<Mesh>()?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(accel_kinds, m)?)?;

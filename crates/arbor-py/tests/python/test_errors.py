@@ -1,5 +1,8 @@
 """Bad input: a ValueError (or OSError for files) with the CLI's wording, never a crash."""
 
+import os
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -138,3 +141,12 @@ def test_help_shows_shapes_dtypes_and_units_and_the_stubs_name_what_exists():
         assert hasattr(ar.Mesh, m), m
     for m in ("intersect", "occluded", "intersect_all", "count_crossings", "contains", "closest_point", "distance", "build", "stats"):
         assert m in methods, m
+
+
+def test_an_unknown_kernel_cap_fails_the_import():
+    env = dict(os.environ, ARBOR_MAX_ISA="avx3")
+    o = subprocess.run([sys.executable, "-c", "import arbor_rays"], env=env, capture_output=True, text=True)
+    assert o.returncode != 0
+    assert 'ValueError: ARBOR_MAX_ISA="avx3": expected avx512, avx2 or sse' in o.stderr
+    env["ARBOR_MAX_ISA"] = "sse"
+    subprocess.run([sys.executable, "-c", "import arbor_rays"], env=env, check=True)

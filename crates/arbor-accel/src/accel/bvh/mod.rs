@@ -49,7 +49,7 @@ pub use bottom_up::{BottomUpMethod, BottomUpParams, MergeCost};
 pub use params::{BvhParams, MedianParams};
 use recipe::Recipe;
 use wide::Kernel;
-pub use wide::{Node8, Wide};
+pub use wide::{Isa, Node8, Wide, MAX_ISA_VAR};
 
 use super::nearest;
 use super::stats::StatsTally;
@@ -62,7 +62,7 @@ pub const LEAF_HARD_MAX: usize = 64;
 
 /// The node-test kernel the wide BVH's queries run on this processor, detected at run time: `avx512`
 /// (8 lanes at once, the whole query compiled for AVX-512 F and VL), `avx2` (8 lanes at once, compiled
-/// for AVX2), `sse` (two 4-lane halves) or `scalar`.
+/// for AVX2), `sse` (two 4-lane halves) or `scalar`; [`MAX_ISA_VAR`] caps it.
 pub fn query_kernel() -> &'static str {
     Kernel::detect().name()
 }

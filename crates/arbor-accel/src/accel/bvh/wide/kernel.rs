@@ -60,6 +60,39 @@ impl Avx512 {
     }
 }
 
+/// The variable that caps the kernel below the processor's best, to measure Arbor as it runs on an older
+/// processor (as oneDNN's `ONEDNN_MAX_CPU_ISA` does): `avx2`, `sse`, or `avx512` (no cap, as unset or
+/// empty). Only the node-test kernels use wider instructions than the x86_64 baseline, so under `avx2`
+/// the whole program runs as on an AVX2-only processor.
+pub const MAX_ISA_VAR: &str = "ARBOR_MAX_ISA";
+
+/// The instruction sets [`MAX_ISA_VAR`] can cap the kernel at, lowest first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Isa {
+    /// The x86_64 baseline: [`Kernel::Sse`].
+    Sse,
+    /// [`Kernel::Avx2`] at most.
+    Avx2,
+    /// [`Kernel::Avx512`] at most: no cap.
+    Avx512,
+}
+
+impl Isa {
+    /// The cap [`MAX_ISA_VAR`] sets (`None` when unset or empty), or the error that names its value
+    /// when it names no instruction set. [`Kernel::detect`] reads it once, and takes an unknown value
+    /// as no cap: programs check it first (`arbor` refuses to start).
+    pub fn cap_from_env() -> Result<Option<Isa>, String> {
+        let Some(value) = std::env::var_os(MAX_ISA_VAR) else { return Ok(None) };
+        match value.to_str() {
+            Some("") => Ok(None),
+            Some("avx512") => Ok(Some(Isa::Avx512)),
+            Some("avx2") => Ok(Some(Isa::Avx2)),
+            Some("sse") => Ok(Some(Isa::Sse)),
+            _ => Err(format!("{MAX_ISA_VAR}={:?}: expected avx512, avx2 or sse", value.to_string_lossy())),
+        }
+    }
+}
+
 /// The two-halves kernel (SSE2, the x86_64 baseline).
 #[cfg(target_arch = "x86_64")]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,15 +120,19 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    /// The fastest kernel this processor runs (the scalar one under Miri).
+    /// The fastest kernel this processor runs, up to the cap of [`MAX_ISA_VAR`] (the scalar one under
+    /// Miri).
     #[inline]
     pub fn detect() -> Kernel {
         #[cfg(all(target_arch = "x86_64", not(miri)))]
         {
-            if let Some(avx512) = Avx512::detect() {
+            // Read once: every query asks, and then costs a load and a comparison.
+            static CAP: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
+            let cap = *CAP.get_or_init(|| Isa::cap_from_env().ok().flatten().unwrap_or(Isa::Avx512));
+            if let Some(avx512) = Avx512::detect().filter(|_| cap >= Isa::Avx512) {
                 return Kernel::Avx512(avx512);
             }
-            match Avx2::detect() {
+            match Avx2::detect().filter(|_| cap >= Isa::Avx2) {
                 Some(avx2) => Kernel::Avx2(avx2),
                 None => Kernel::Sse,
             }

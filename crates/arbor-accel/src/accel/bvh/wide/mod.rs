@@ -56,6 +56,7 @@ pub(super) use collapse::PLAN_PARALLEL;
 pub(super) use kernel::Kernel;
 #[cfg(test)]
 pub(super) use kernel::{Avx2, Avx512};
+pub use kernel::{Isa, MAX_ISA_VAR};
 pub(super) use nearest::closest_point;
 pub(super) use packet::intersect_coherent_with;
 
