@@ -497,6 +497,34 @@ def render_mitsuba(variant, path, camera_id, spp, threads, max_depth, seed=0, sa
     return np.array(img)[..., :3], seconds
 
 
+def cap_isa(isa):
+    """Caps Mitsuba's LLVM kernels at `isa` and returns the environment of Arbor's renders (ARBOR_MAX_ISA).
+    avx2: Dr.Jit's target stays this processor, with every AVX-512 (and AMX, AVX10) feature turned off,
+    at 8 lanes: this processor as an AVX2-only one. (Targeting `haswell` instead made Mitsuba 1.5x slower
+    again on a Sapphire Rapids: that measures another processor's tuning, not the instruction set.)
+    Dr.Jit has no Python call for its target, so its C++ one is called by its mangled name; Embree, inside
+    libmitsuba, keeps the instruction set it detects (Mitsuba's device reads no configuration to cap it)."""
+    import ctypes
+    env = dict(os.environ)
+    if isa == "native":
+        env.pop("ARBOR_MAX_ISA", None)
+        return env
+    core = ctypes.CDLL(os.path.join(os.path.dirname(dr.__file__), "libdrjit-core.so"))
+    core._Z19jit_llvm_target_cpuv.restype = core._Z24jit_llvm_target_featuresv.restype = ctypes.c_char_p
+    mi.set_variant(REF_VARIANT)
+    dr.eval(dr.llvm.Float(1.0))  # the LLVM backend is set up: the target below is not replaced
+    cpu, features = core._Z19jit_llvm_target_cpuv(), core._Z24jit_llvm_target_featuresv().split(b",")
+    wide = (b"+avx512", b"+amx", b"+avx10")
+    features = [b"-" + f[1:] if f.startswith(wide) else f for f in features]
+    core._Z19jit_llvm_set_targetPKcS0_j(cpu, b",".join(features), 8)
+    width = core._Z21jit_llvm_vector_widthv()
+    if width != 8:
+        sys.exit(f"cannot cap Dr.Jit at AVX2: its vector width is {width} after setting 8")
+    print(f"Dr.Jit's target: {cpu.decode()} without AVX-512, 8 lanes; Arbor: ARBOR_MAX_ISA={isa}", flush=True)
+    env["ARBOR_MAX_ISA"] = isa
+    return env
+
+
 def arbor_missing(arbor, integrator, path_options):
     """Why Arbor cannot be run as asked, or None."""
     if not Path(arbor).exists():
@@ -511,8 +539,10 @@ def arbor_missing(arbor, integrator, path_options):
     return None
 
 
-def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0, sampler=None):
-    """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed."""
+def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads, out, seed=0, sampler=None,
+                 env=None):
+    """(image, seconds of rendering from Arbor's `--stats-json`), or None with the reason printed; in
+    environment `env` (--isa), whose kernel cap the stats must show."""
     stats = Path(str(out) + ".stats.json")
     # The unbiased roulette for a camera with one (a camera's RussianRoulette is otherwise the course's).
     cmd = [arbor, "render", str(path), "--camera", camera_id, "--spp", str(spp), "--threads", str(threads),
@@ -523,12 +553,16 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
         cmd += ["--path-options", path_options]
     if sampler:
         cmd += ["--sampler", sampler]
-    run = subprocess.run(cmd, capture_output=True, text=True)
+    run = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if run.returncode != 0 or not stats.is_file():
         print(f"  Arbor failed (exit {run.returncode}): {' '.join(cmd)}\n    " +
               (run.stderr.strip() or run.stdout.strip()).replace("\n", "\n    "))
         return None
-    render_ms = json.loads(stats.read_text())["images"][0]["render_ms"]
+    image = json.loads(stats.read_text())["images"][0]
+    cap = (env or {}).get("ARBOR_MAX_ISA")
+    if cap and image.get("kernel") != cap:
+        sys.exit(f"Arbor ran kernel {image.get('kernel')} under ARBOR_MAX_ISA={cap} (a build before the cap?)")
+    render_ms = image["render_ms"]
     return read_bitmap(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
 
@@ -660,17 +694,18 @@ def compare_scene(args, spec, arbor_ok):
         name = "Arbor" if args.arbor_sampler is None else f"Arbor ({args.arbor_sampler})"
         renderers.append((name, lambda t: render_arbor(args.arbor, args.arbor_integrator, args.arbor_path_options,
                                                        args.arbor_path, camera_id, args.spp, t, out,
-                                                       sampler=args.arbor_sampler)))
+                                                       sampler=args.arbor_sampler, env=args.env)))
     for name, render in renderers:
         for threads in args.threads:
             result = render(threads)
             if result is None:
                 continue
             img, seconds = result
-            row = {"scene": f"{path.stem}:{camera_id}", "renderer": name, "threads": threads,
+            name_isa = name if args.isa == "native" else f"{name} [{args.isa}]"
+            row = {"scene": f"{path.stem}:{camera_id}", "renderer": name_isa, "threads": threads,
                    "load": os.getloadavg()[0], "seconds": seconds, "samples_per_s": samples / seconds,
                    "rmse_mitsuba": rmse(img, refs["Mitsuba"]), "rmse_arbor": rmse(img, refs["Arbor"])}
-            print(f"  {name:12} {threads} threads: {seconds:7.2f} s  {row['samples_per_s'] / 1e6:6.2f} M samples/s  "
+            print(f"  {name_isa:12} {threads} threads: {seconds:7.2f} s  {row['samples_per_s'] / 1e6:6.2f} M samples/s  "
                   f"RMSE vs Mitsuba ref {fmt(row['rmse_mitsuba'])}  vs Arbor ref {fmt(row['rmse_arbor'])}  "
                   f"load {row['load']:.1f}", flush=True)
             rows.append(row)
@@ -712,7 +747,12 @@ def main():
     parser.add_argument("--ref-spp", type=int, default=1024, help="samples per pixel of the reference renders")
     parser.add_argument("--cache", type=Path, default=Path("target/mitsuba-compare"), help="folder of references")
     parser.add_argument("--max-depth", type=int, help="Mitsuba's max_depth instead of MaxRecursionDepth + 2 (Mitsuba only)")
+    parser.add_argument("--isa", choices=["native", "avx2"], default="native",
+                        help="avx2: both renderers' vectorised code capped at AVX2 on an AVX-512 processor (Arbor's "
+                             "kernel by ARBOR_MAX_ISA; Mitsuba's LLVM kernels by Dr.Jit's target, this processor "
+                             "without AVX-512 at 8 lanes; Embree keeps what it detects)")
     args = parser.parse_args()
+    args.env = cap_isa(args.isa)
     args.threads = [int(t) for t in args.threads.split(",")]
     args.variants = args.variants.split(",")
     args.cache.mkdir(parents=True, exist_ok=True)
