@@ -1,21 +1,9 @@
 //! `arbor bench` and `arbor render --debug` as a user runs them: rows, JSON, exit codes, images.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
 use arbor::accel::AccelKind;
-
-fn arbor(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arbor")).args(args).current_dir(cwd).output().expect("arbor runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{arbor, stderr, stdout};
 
 const QUICK: &[&str] = &["bench", "sphere:3000", "--size", "40x30", "--runs", "1"];
 

@@ -1,19 +1,12 @@
 //! The `arbor` binary as a user runs it: outputs, summary lines and exit codes.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
+use std::sync::LazyLock;
 
-fn arbor(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arbor")).args(args).current_dir(cwd).output().expect("arbor runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+use common::{arbor, stderr, stdout};
 
 fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.join(name);
@@ -21,9 +14,11 @@ fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     p
 }
 
-const TINY: &str = r#"<Scene>
-    <Cameras>
-        <Camera id="1">
+/// The shared sphere seen by one camera of 24x16 pixels whose image is `tiny.IMAGE_EXT` (tests put in
+/// the extension).
+static TINY: LazyLock<String> = LazyLock::new(|| {
+    common::sphere_scene(
+        r#"        <Camera id="1">
             <Position>0 0 5</Position>
             <Gaze>0 0 -1</Gaze>
             <Up>0 1 0</Up>
@@ -31,25 +26,9 @@ const TINY: &str = r#"<Scene>
             <NearDistance>2</NearDistance>
             <ImageResolution>24 16</ImageResolution>
             <ImageName>tiny.IMAGE_EXT</ImageName>
-        </Camera>
-    </Cameras>
-    <Lights>
-        <AmbientLight>30 30 30</AmbientLight>
-        <PointLight id="1"><Position>0 3 5</Position><Intensity>900 900 900</Intensity></PointLight>
-    </Lights>
-    <Materials>
-        <Material id="1">
-            <AmbientReflectance>1 1 1</AmbientReflectance>
-            <DiffuseReflectance>1 0.5 0.2</DiffuseReflectance>
-            <SpecularReflectance>0 0 0</SpecularReflectance>
-        </Material>
-    </Materials>
-    <VertexData>0 0 0</VertexData>
-    <Objects>
-        <Sphere id="1"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere>
-    </Objects>
-</Scene>
-"#;
+        </Camera>"#,
+    )
+});
 
 #[test]
 fn cli_renders_builtin_example_with_summary_line() {

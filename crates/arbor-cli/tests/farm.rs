@@ -3,12 +3,13 @@
 //! (PNG and EXR); wrong slices are usage errors (exit 2) and parts that do not fit exit 3, each with
 //! its exact message.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn arbor(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arbor")).args(args).current_dir(cwd).output().expect("arbor runs")
-}
+use std::path::Path;
+use std::process::Command;
+use std::sync::LazyLock;
+
+use common::arbor;
 
 fn ok(args: &[&str], cwd: &Path) -> String {
     let o = arbor(args, cwd);
@@ -26,10 +27,10 @@ fn same_file(a: &Path, b: &Path) {
     assert!(x == y, "{} and {} differ", a.display(), b.display());
 }
 
-/// Two cameras looking at a sphere under an area-free light; 4 samples per pixel (jittered strata).
-const TWO_CAMERAS: &str = r#"<Scene>
-    <Cameras>
-        <Camera id="front">
+/// Two cameras looking at the shared sphere; 4 samples per pixel (jittered strata).
+static TWO_CAMERAS: LazyLock<String> = LazyLock::new(|| {
+    common::sphere_scene(
+        r#"        <Camera id="front">
             <Position>0 0 5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>
             <NearPlane>-1 1 -1 1</NearPlane><NearDistance>2</NearDistance>
             <ImageResolution>37 23</ImageResolution><NumSamples>4</NumSamples>
@@ -40,25 +41,9 @@ const TWO_CAMERAS: &str = r#"<Scene>
             <NearPlane>-1 1 -1 1</NearPlane><NearDistance>2</NearDistance>
             <ImageResolution>29 31</ImageResolution><NumSamples>4</NumSamples>
             <ImageName>side.png</ImageName>
-        </Camera>
-    </Cameras>
-    <Lights>
-        <AmbientLight>30 30 30</AmbientLight>
-        <PointLight id="1"><Position>0 3 5</Position><Intensity>900 900 900</Intensity></PointLight>
-    </Lights>
-    <Materials>
-        <Material id="1">
-            <AmbientReflectance>1 1 1</AmbientReflectance>
-            <DiffuseReflectance>1 0.5 0.2</DiffuseReflectance>
-            <SpecularReflectance>0 0 0</SpecularReflectance>
-        </Material>
-    </Materials>
-    <VertexData>0 0 0</VertexData>
-    <Objects>
-        <Sphere id="1"><Material>1</Material><Center>1</Center><Radius>1</Radius></Sphere>
-    </Objects>
-</Scene>
-"#;
+        </Camera>"#,
+    )
+});
 
 #[test]
 fn farm_cli_tiles_of_the_example_merge_to_the_whole_png() {
@@ -113,7 +98,7 @@ fn farm_cli_cameras_tiles_and_sample_ranges_merge_to_the_whole_exr() {
 fn farm_cli_refuses_wrong_slices_and_parts() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    std::fs::write(d.join("two.xml"), TWO_CAMERAS).unwrap();
+    std::fs::write(d.join("two.xml"), &*TWO_CAMERAS).unwrap();
     let usage = [
         (&["--tile", "4/4", "--camera", "front", "-o", "a.exr"][..], "error: --tile 4/4: the index is 0-based, so it must be below 4\n"),
         (&["--tile", "0/0", "--camera", "front", "-o", "a.exr"][..], "error: --tile I/N needs N >= 1\n"),
@@ -165,7 +150,7 @@ fn farm_cli_refuses_wrong_slices_and_parts() {
 fn farm_cli_stats_json_and_plain_progress_lines() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    std::fs::write(d.join("two.xml"), TWO_CAMERAS).unwrap();
+    std::fs::write(d.join("two.xml"), &*TWO_CAMERAS).unwrap();
     let o = arbor(&["render", "two.xml", "--camera", "side", "--stats-json", "stats.json", "-o", "out"], d);
     assert!(o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
@@ -202,7 +187,7 @@ fn farm_slurm_submit_without_sbatch_creates_nothing() {
     for tool in ["bash", "realpath", "dirname", "mkdir"] {
         std::os::unix::fs::symlink(on_path(tool), bin.join(tool)).unwrap();
     }
-    std::fs::write(tmp.path().join("scene.xml"), TWO_CAMERAS).unwrap();
+    std::fs::write(tmp.path().join("scene.xml"), &*TWO_CAMERAS).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy/slurm/submit.sh");
     let submit = || {
         Command::new(bin.join("bash"))

@@ -6,6 +6,9 @@
 
 #![cfg(unix)]
 
+mod common;
+
+use common::stderr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -31,10 +34,6 @@ fn arbor(args: &[&str], cwd: &Path) -> Output {
     let mut cmd = Command::new(ARBOR);
     cmd.args(args).current_dir(cwd);
     finish(cmd, Duration::from_secs(20))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn entries(dir: &Path) -> Vec<String> {
