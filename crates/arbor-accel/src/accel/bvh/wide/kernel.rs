@@ -69,18 +69,18 @@ pub const MAX_ISA_VAR: &str = "ARBOR_MAX_ISA";
 /// The instruction sets [`MAX_ISA_VAR`] can cap the kernel at, lowest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Isa {
-    /// The x86_64 baseline: [`Kernel::Sse`].
+    /// The x86_64 baseline: the two-halves SSE2 kernel.
     Sse,
-    /// [`Kernel::Avx2`] at most.
+    /// The AVX2 kernel at most.
     Avx2,
-    /// [`Kernel::Avx512`] at most: no cap.
+    /// The AVX-512 kernel at most: no cap.
     Avx512,
 }
 
 impl Isa {
     /// The cap [`MAX_ISA_VAR`] sets (`None` when unset or empty), or the error that names its value
-    /// when it names no instruction set. [`Kernel::detect`] reads it once, and takes an unknown value
-    /// as no cap: programs check it first (`arbor` refuses to start).
+    /// when it names no instruction set. The kernel's detection reads it once, and takes an unknown
+    /// value as no cap: programs check it first (`arbor` refuses to start).
     pub fn cap_from_env() -> Result<Option<Isa>, String> {
         let Some(value) = std::env::var_os(MAX_ISA_VAR) else { return Ok(None) };
         match value.to_str() {
