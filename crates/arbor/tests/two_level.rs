@@ -10,6 +10,9 @@ use arbor::math::{Color, Ray, Transform, Vec3};
 use arbor::scene::{build_geometry, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
 use arbor::Location;
 
+mod common;
+use common::soups::{closed_cube, mesh_of};
+
 fn quad() -> Arc<TriangleMesh> {
     Arc::new(TriangleMesh {
         positions: vec![
@@ -200,7 +203,7 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
 
 #[test]
 fn two_level_batches_give_every_ray_its_own_querys_hit() {
-    // One transformed mesh with a plane beside it, a few large objects (both swept object by object), a
+    // One transformed mesh with a plane beside it, a few large objects, one moving (both swept object by object), a
     // few small ones and a random scene of many (each ray walks the top level); invalid rays mixed in.
     let mut rng = Lcg(23);
     let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
@@ -220,9 +223,12 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         Arc::new(TriangleMesh { positions, indices, ..Default::default() })
     };
     let u = Transform::translate(Vec3::new(-2.0, 0.0, 1.0));
+    // The second one moves over the shutter interval: the sweep culls by its swept box.
+    let mut moving = object("Mesh", inline(&big(&mut rng)), u);
+    moving.motion = Vec3::new(0.0, 3.0, -1.0);
     let few_large = desc(vec![
         object("Mesh", inline(&big(&mut rng)), t),
-        object("Mesh", inline(&big(&mut rng)), u),
+        moving,
         object("MeshInstance", ShapeDesc::Instance { base: 0 }, t),
         object("Sphere", ShapeDesc::Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 1.5 }, Transform::IDENTITY),
     ]);
@@ -237,7 +243,7 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
         let mut rays: Vec<Ray> = (0..3_000)
             .map(|_| {
                 let o = rng.v(30.0);
-                Ray::new(o, rng.v(12.0) - o)
+                Ray::new(o, rng.v(12.0) - o).with_time(rng.f())
             })
             .collect();
         rays[10] = Ray::new(Vec3::NAN, Vec3::X);
@@ -252,6 +258,73 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
                     let mut out = vec![None; n];
                     g.intersect_many(&rays[..n], t_max, &mut out);
                     assert_eq!(out, single[..n], "{kind}, t_max {t_max}, batch of {n}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn two_level_swept_batches_turn_away_no_ray_that_grazes_an_objects_box() {
+    // The sweep sends an object only the rays that may meet its box before their closest hit so far.
+    // Cubes whose faces lie on their boxes, hit on their edges and corners, along their faces and from
+    // points on them, near the origin, at 1e5 and scaled by 1e-4: a second cube overlaps the first, and
+    // an instance of the first sits in its very place (its hits tie with the first's and go to it).
+    for (scale, offset) in [(1.0, 0.0), (1e-4, 0.0), (1.0, 1e5)] {
+        let place = |p: Vec3| p * scale + Vec3::splat(offset);
+        let cube = |at: Vec3| {
+            let tris: Vec<[Vec3; 3]> = closed_cube(8).iter().map(|t| t.map(|p| place(p + at))).collect();
+            ShapeDesc::Mesh { source: MeshSource::Inline(Arc::new(mesh_of(&tris))), smooth: false }
+        };
+        let d = desc(vec![
+            object("Mesh", cube(Vec3::ZERO), Transform::IDENTITY),
+            object("Mesh", cube(Vec3::new(4.0, 4.0, 0.0)), Transform::IDENTITY),
+            object("MeshInstance", ShapeDesc::Instance { base: 0 }, Transform::IDENTITY),
+        ]);
+        let mut rng = Lcg(41);
+        let lattice = |rng: &mut Lcg, n: usize| {
+            let mut c = || (rng.f() * (n + 1) as f32).floor();
+            place(Vec3::new(c(), c(), c()))
+        };
+        let mut rays = Vec::new();
+        for k in 0..4_000 {
+            // Lattice points of both cubes, on and between their edges and faces.
+            let target = lattice(&mut rng, 12);
+            let origin = match k % 4 {
+                // From far away, and from near.
+                0 => place(rng.v(60.0) + Vec3::splat(6.0)),
+                1 => place(rng.v(16.0) + Vec3::splat(6.0)),
+                // From another lattice point: on a face, or along one.
+                _ => lattice(&mut rng, 12),
+            };
+            if origin != target {
+                rays.push(Ray::new(origin, target - origin));
+            }
+        }
+        // Along the planes of the first cube's faces, from outside it, to the edges where the faces
+        // across meet them: a slab distance of `0 * inf`, NaN, on the axis the ray lies in.
+        for (axis, along) in [(0, 1), (1, 2), (2, 0)] {
+            for face in [0.0, 8.0] {
+                for sign in [1.0, -1.0] {
+                    let (mut o, mut dir) = (Vec3::splat(3.5), Vec3::ZERO);
+                    o[axis] = face;
+                    o[along] = 4.0 - 6.0 * sign;
+                    dir[along] = sign;
+                    rays.push(Ray::new(place(o), dir));
+                }
+            }
+        }
+        for &kind in AccelKind::ALL {
+            let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
+            assert!(g.sweeps(), "{kind}: three cubes of 768 triangles are swept");
+            for t_max in [f32::INFINITY, 1.0] {
+                let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
+                let mut out = vec![None; rays.len()];
+                g.intersect_many(&rays, t_max, &mut out);
+                let hits = single.iter().filter(|h| h.is_some()).count();
+                assert!(hits > rays.len() / 3, "{kind}, scale {scale}, offset {offset}: only {hits} hits");
+                for (i, (a, b)) in out.iter().zip(&single).enumerate() {
+                    assert_eq!(a, b, "{kind}, scale {scale}, offset {offset}, t_max {t_max}: ray {:?}", rays[i]);
                 }
             }
         }

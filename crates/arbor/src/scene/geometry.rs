@@ -23,9 +23,12 @@ use crate::geometry::{Plane, Sphere, TriangleMesh};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 
 mod summary;
+mod sweep;
+
+use sweep::BatchRays;
 
 /// Scenes of at most this many bounded objects trace batches object by object
-/// ([`SceneGeometry::intersect_many`]), every ray meeting every object's root ...
+/// ([`SceneGeometry::intersect_many`]), every ray meeting every object's box ...
 pub const SWEEP_OBJECTS: usize = 8;
 /// ... when they hold this many triangles per object on average: a large mesh traced by a whole batch
 /// (two rays at a time) gains more than the rays with no business in it cost, while small objects (a
@@ -235,9 +238,12 @@ impl SceneGeometry {
     /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
     ///
     /// A scene of a few large meshes ([`SceneGeometry::sweeps`]) is swept object by object, each mesh
-    /// tracing the whole batch ([`Accel::intersect_many`]) up to the closest hit so far, which a later
-    /// object must beat strictly (ties go to the lowest object, as at the top level); otherwise each ray
-    /// walks the top level on its own.
+    /// tracing the rays of the batch that may meet its box ([`BatchRays::may_meet`]) together
+    /// ([`Accel::intersect_many`]) up to the closest hit so far, which a later object must beat
+    /// strictly (ties go to the lowest object, as at the top level); otherwise each ray walks the top
+    /// level on its own. The box test across the batch is what the top level's walk would do for a
+    /// ray: without it every ray paid a whole query of every object (in a Cornell box holding a large
+    /// mesh, its walls took half the camera rays' instructions).
     ///
     /// # Panics
     /// When `rays` and `out` differ in length.
@@ -251,18 +257,37 @@ impl SceneGeometry {
         }
         out.fill(None);
         let mut limit = vec![t_max; rays.len()];
-        let (mut local, mut found) = (Vec::new(), Vec::new());
+        let (mut keep, mut which, mut local, mut local_limit, mut found) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        // One object's own root box turns rays away as well as this test would.
+        let mut batch = (self.objects.objects.len() > 1).then(|| BatchRays::new(rays));
         for (i, object) in self.objects.objects.iter().enumerate() {
             match &object.shape {
                 Shape::Mesh(m) => {
+                    // Only the rays that may meet the object's box before their closest hit so far,
+                    // gathered when some may not.
+                    which.clear();
+                    if let Some(batch) = &mut batch {
+                        batch.may_meet(&object.bounds, &limit, &mut keep);
+                        which.extend((0..rays.len() as u32).filter(|&j| keep[j as usize]));
+                    }
+                    let all = batch.is_none() || which.len() == rays.len();
                     local.clear();
-                    local.extend(rays.iter().map(|r| object.local_ray(r)));
-                    found.resize(rays.len(), None);
-                    m.accel.intersect_many(&m.mesh, &local, &limit, &mut found);
-                    for ((o, l), h) in out.iter_mut().zip(&mut limit).zip(&found) {
+                    if all {
+                        local.extend(rays.iter().map(|r| object.local_ray(r)));
+                    } else {
+                        local.extend(which.iter().map(|&j| object.local_ray(&rays[j as usize])));
+                        local_limit.clear();
+                        local_limit.extend(which.iter().map(|&j| limit[j as usize]));
+                    }
+                    found.clear();
+                    found.resize(local.len(), None);
+                    m.accel.intersect_many(&m.mesh, &local, if all { &limit } else { &local_limit }, &mut found);
+                    for (k, h) in found.iter().enumerate() {
                         if let Some(h) = h {
-                            *o = Some(Hit::new(i as u32, nested(*h)));
-                            *l = h.t;
+                            let j = if all { k } else { which[k] as usize };
+                            out[j] = Some(Hit::new(i as u32, nested(*h)));
+                            limit[j] = h.t;
                         }
                     }
                 }
