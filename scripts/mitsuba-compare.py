@@ -561,7 +561,10 @@ def render_arbor(arbor, integrator, path_options, path, camera_id, spp, threads,
     image = json.loads(stats.read_text())["images"][0]
     cap = (env or {}).get("ARBOR_MAX_ISA")
     if cap and image.get("kernel") != cap:
-        sys.exit(f"Arbor ran kernel {image.get('kernel')} under ARBOR_MAX_ISA={cap} (a build before the cap?)")
+        # No kernel field: a build from before the cap. Another kernel: this processor lacks the capped one.
+        why = "a build before the cap" if image.get("kernel") is None else "this processor lacks it"
+        sys.exit(f"Arbor ran kernel {image.get('kernel')} under ARBOR_MAX_ISA={cap} ({why}): the comparison "
+                 "would not be of that instruction set")
     render_ms = image["render_ms"]
     return read_bitmap(out), render_ms / 1e3  # Arbor's EXR holds radiance in the scene's units
 
