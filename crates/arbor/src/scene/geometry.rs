@@ -238,7 +238,7 @@ impl SceneGeometry {
     /// `rays[i]`'s hit in `(0, t_max)`, the same hit as its own query.
     ///
     /// A scene of a few large meshes ([`SceneGeometry::sweeps`]) is swept object by object, each mesh
-    /// tracing the rays of the batch that may meet its box ([`BatchRays::may_meet`]) together
+    /// tracing the rays of the batch that may meet its box (the box test of `sweep.rs`) together
     /// ([`Accel::intersect_many`]) up to the closest hit so far, which a later object must beat
     /// strictly (ties go to the lowest object, as at the top level); otherwise each ray walks the top
     /// level on its own. The box test across the batch is what the top level's walk would do for a
