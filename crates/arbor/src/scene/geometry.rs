@@ -257,8 +257,7 @@ impl SceneGeometry {
         }
         out.fill(None);
         let mut limit = vec![t_max; rays.len()];
-        let (mut keep, mut which, mut local, mut local_limit, mut found) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut which, mut local, mut local_limit, mut found) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         // One object's own root box turns rays away as well as this test would.
         let mut batch = (self.objects.objects.len() > 1).then(|| BatchRays::new(rays));
         for (i, object) in self.objects.objects.iter().enumerate() {
@@ -268,8 +267,7 @@ impl SceneGeometry {
                     // gathered when some may not.
                     which.clear();
                     if let Some(batch) = &mut batch {
-                        batch.may_meet(&object.bounds, &limit, &mut keep);
-                        which.extend((0..rays.len() as u32).filter(|&j| keep[j as usize]));
+                        batch.may_meet(&object.bounds, &limit, &mut which);
                     }
                     let all = batch.is_none() || which.len() == rays.len();
                     local.clear();

@@ -14,13 +14,14 @@ use crate::math::{Aabb, Ray};
 const CULL_SLACK: f32 = 1.0 / 4096.0;
 
 /// A batch's ray origins and reciprocal directions, axis by axis, for [`BatchRays::may_meet`], and
-/// that test's running bounds, one per ray.
+/// that test's running bounds and verdicts, one per ray.
 pub(super) struct BatchRays {
     origin: [Vec<f32>; 3],
     inv_dir: [Vec<f32>; 3],
     near: Vec<f32>,
     far: Vec<f32>,
     scale: Vec<f32>,
+    keep: Vec<bool>,
 }
 
 impl BatchRays {
@@ -33,12 +34,13 @@ impl BatchRays {
             near: vec![0.0; rays.len()],
             far: vec![0.0; rays.len()],
             scale: vec![0.0; rays.len()],
+            keep: vec![false; rays.len()],
         }
     }
 
-    /// Whether each ray may meet what box `b` holds before its `limit`, into `keep`: the top level's
-    /// conservative slab test (`arbor-accel`'s `bvh/traverse.rs` argues it: the exit enlarged by a
-    /// slack times the slab distances, which bounds a hit's rounding), with more slack than the top
+    /// The rays that may meet what box `b` holds before their `limit`, by index into `which`: the top
+    /// level's conservative slab test (`arbor-accel`'s `bvh/traverse.rs` argues it: the exit enlarged by
+    /// a slack times the slab distances, which bounds a hit's rounding), with more slack than the top
     /// level gives the same box, so that it turns away no ray the top level would let in. As there,
     /// the planes a ray enters and leaves by are chosen by the sign of its direction, and a distance
     /// that is NaN (a ray along a slab's plane, `0 * inf`) does not count against the ray: each
@@ -46,7 +48,7 @@ impl BatchRays {
     /// SIMD lanes: a few instructions per ray.
     // `!(near > far + slack)`, not `near <= far + slack`: a NaN keeps the ray.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    pub(super) fn may_meet(&mut self, b: &Aabb, limit: &[f32], keep: &mut Vec<bool>) {
+    pub(super) fn may_meet(&mut self, b: &Aabb, limit: &[f32], which: &mut Vec<u32>) {
         let n = limit.len();
         let (near, far, scale) = (&mut self.near[..n], &mut self.far[..n], &mut self.scale[..n]);
         near.fill(0.0);
@@ -64,7 +66,12 @@ impl BatchRays {
                 scale[j] = if size > scale[j] { size } else { scale[j] };
             }
         }
-        keep.clear();
-        keep.extend((0..n).map(|j| !(near[j] > far[j] + scale[j] * CULL_SLACK)));
+        // The verdicts in a pass of their own, which runs across lanes, then the indices.
+        let keep = &mut self.keep[..n];
+        for j in 0..n {
+            keep[j] = !(near[j] > far[j] + scale[j] * CULL_SLACK);
+        }
+        which.clear();
+        which.extend((0..n as u32).filter(|&j| keep[j as usize]));
     }
 }
