@@ -699,12 +699,12 @@ def compare_scene(args, spec, arbor_ok):
                                                        args.arbor_path, camera_id, args.spp, t, out,
                                                        sampler=args.arbor_sampler, env=args.env)))
     for name, render in renderers:
+        name_isa = name if args.isa == "native" else f"{name} [{args.isa}]"
         for threads in args.threads:
             result = render(threads)
             if result is None:
                 continue
             img, seconds = result
-            name_isa = name if args.isa == "native" else f"{name} [{args.isa}]"
             row = {"scene": f"{path.stem}:{camera_id}", "renderer": name_isa, "threads": threads,
                    "load": os.getloadavg()[0], "seconds": seconds, "samples_per_s": samples / seconds,
                    "rmse_mitsuba": rmse(img, refs["Mitsuba"]), "rmse_arbor": rmse(img, refs["Arbor"])}

@@ -7,7 +7,9 @@ use std::sync::Arc;
 use arbor::accel::{AccelConfig, AccelKind};
 use arbor::geometry::TriangleMesh;
 use arbor::math::{Color, Ray, Transform, Vec3};
-use arbor::scene::{build_geometry, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, ShapeDesc};
+use arbor::scene::{
+    build_geometry, MaterialDesc, MaterialKind, MeshSource, ObjectDesc, SceneDesc, SceneGeometry, ShapeDesc,
+};
 use arbor::Location;
 
 mod common;
@@ -203,8 +205,9 @@ fn two_level_hits_agree_with_the_same_geometry_flattened_into_world_space() {
 
 #[test]
 fn two_level_batches_give_every_ray_its_own_querys_hit() {
-    // One transformed mesh with a plane beside it, a few large objects, one moving (both swept object by object), a
-    // few small ones and a random scene of many (each ray walks the top level); invalid rays mixed in.
+    // One transformed mesh with a plane beside it, a few large objects, one moving (both swept object by
+    // object), a few small ones and a random scene of many (each ray walks the top level); invalid rays
+    // mixed in.
     let mut rng = Lcg(23);
     let positions: Vec<Vec3> = (0..300).map(|_| rng.v(4.0)).collect();
     let indices: Vec<[u32; 3]> = (0..200).map(|k| [k * 3 % 300, (k * 3 + 1) % 300, (k * 3 + 2) % 300]).collect();
@@ -252,16 +255,25 @@ fn two_level_batches_give_every_ray_its_own_querys_hit() {
             let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
             assert_eq!(g.sweeps(), sweep, "{kind}: {} objects", g.objects.objects.len());
             for t_max in [f32::INFINITY, 20.0] {
-                let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
-                assert!(single.iter().filter(|h| h.is_some()).count() > 200, "{kind}: the rays must hit");
-                for n in [0, 1, 2, 3, rays.len()] {
-                    let mut out = vec![None; n];
-                    g.intersect_many(&rays[..n], t_max, &mut out);
-                    assert_eq!(out, single[..n], "{kind}, t_max {t_max}, batch of {n}");
-                }
+                let hits = check_batches(&g, &rays, t_max, &[0, 1, 2, 3, rays.len()], &kind.to_string());
+                assert!(hits > 200, "{kind}: the rays must hit");
             }
         }
     }
+}
+
+/// `g.intersect_many` over the first `n` of `rays` for each `n` of `batches` gives every ray the very hit
+/// its own query gives in `(0, t_max)`; returns how many of `rays` hit.
+fn check_batches(g: &SceneGeometry, rays: &[Ray], t_max: f32, batches: &[usize], what: &str) -> usize {
+    let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
+    for &n in batches {
+        let mut out = vec![None; n];
+        g.intersect_many(&rays[..n], t_max, &mut out);
+        for (i, (a, b)) in out.iter().zip(&single).enumerate() {
+            assert_eq!(a, b, "{what}, t_max {t_max}, batch of {n}: ray {i} {:?}", rays[i]);
+        }
+    }
+    single.iter().filter(|h| h.is_some()).count()
 }
 
 #[test]
@@ -318,14 +330,9 @@ fn two_level_swept_batches_turn_away_no_ray_that_grazes_an_objects_box() {
             let g = build_geometry(&d, &AccelConfig::from(kind)).unwrap();
             assert!(g.sweeps(), "{kind}: three cubes of 768 triangles are swept");
             for t_max in [f32::INFINITY, 1.0] {
-                let single: Vec<_> = rays.iter().map(|r| g.intersect(r, t_max)).collect();
-                let mut out = vec![None; rays.len()];
-                g.intersect_many(&rays, t_max, &mut out);
-                let hits = single.iter().filter(|h| h.is_some()).count();
-                assert!(hits > rays.len() / 3, "{kind}, scale {scale}, offset {offset}: only {hits} hits");
-                for (i, (a, b)) in out.iter().zip(&single).enumerate() {
-                    assert_eq!(a, b, "{kind}, scale {scale}, offset {offset}, t_max {t_max}: ray {:?}", rays[i]);
-                }
+                let what = format!("{kind}, scale {scale}, offset {offset}");
+                let hits = check_batches(&g, &rays, t_max, &[rays.len()], &what);
+                assert!(hits > rays.len() / 3, "{what}, t_max {t_max}: only {hits} hits");
             }
         }
     }
